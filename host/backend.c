@@ -1,0 +1,51 @@
+#include "backend.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void cbvh_usb_identity(uint16_t *vid, uint16_t *pid) {
+    const char *v = getenv("CBVH_USB_VID"), *p = getenv("CBVH_USB_PID");
+    *vid = v ? (uint16_t)strtoul(v, NULL, 16) : CBVH_USB_VID_DEFAULT;
+    *pid = p ? (uint16_t)strtoul(p, NULL, 16) : CBVH_USB_PID_DEFAULT;
+}
+
+static const cbvh_backend_ops *const probe_order[] = {&cbvh_backend_usb, &cbvh_backend_hid};
+
+static int open_one(const cbvh_backend_ops *ops, const char *arg, cbvh_backend *b, char *err, size_t errlen) {
+    memset(b, 0, sizeof *b);
+    b->ops = ops;
+    snprintf(b->label, sizeof b->label, "%s", ops->name);
+    int rc = ops->open(b, arg, err, errlen);
+    if (rc != CBVH_BACKEND_OK) b->ops = NULL;
+    return rc;
+}
+
+int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen) {
+    if (strcmp(spec, "auto") == 0) {
+        char why[2][200] = {"", ""};
+        for (size_t i = 0; i < sizeof probe_order / sizeof probe_order[0]; i++) {
+            int rc = open_one(probe_order[i], NULL, b, why[i], sizeof why[i]);
+            if (rc == CBVH_BACKEND_OK) return 0;
+        }
+        if (log)
+            fprintf(log, "cbvh: no board found (usb: %s; hid: %s); using the software model\n", why[0], why[1]);
+        return open_one(&cbvh_backend_model, NULL, b, err, errlen) == CBVH_BACKEND_OK ? 0 : -1;
+    }
+    const cbvh_backend_ops *all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid};
+    size_t n = strcspn(spec, ":");
+    const char *arg = spec[n] == ':' ? spec + n + 1 : NULL;
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
+        if (strlen(all[i]->name) == n && strncmp(all[i]->name, spec, n) == 0) {
+            int rc = open_one(all[i], arg, b, err, errlen);
+            if (rc == CBVH_BACKEND_NONE && err[0] == '\0') snprintf(err, errlen, "no %s board found", all[i]->name);
+            return rc == CBVH_BACKEND_OK ? 0 : -1;
+        }
+    }
+    snprintf(err, errlen, "unknown backend '%s' (expected auto, model, usb or hid)", spec);
+    return -1;
+}
+
+void cbvh_backend_close(cbvh_backend *b) {
+    if (b->ops && b->ops->close) b->ops->close(b);
+    b->ops = NULL;
+}

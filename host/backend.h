@@ -1,0 +1,54 @@
+/* One backend interface for every way of running a unit (OpenOCD CMSIS-DAP
+ * style): a table of functions per backend, one backend per file.
+ *   backend_model.c   in-process bit-exact model
+ *   transport_usb.c   libusb bulk (board)
+ *   transport_hid.c   hidapi HID (board)
+ * `auto` probes usb, then hid, then falls back to the model with one line. */
+#ifndef CBVH_HOST_BACKEND_H
+#define CBVH_HOST_BACKEND_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "cbvh/unit_table.h"
+
+typedef struct cbvh_backend cbvh_backend;
+
+typedef struct {
+    const char *name;
+    /* Opens the backend; arg is the text after "name:" (or NULL).
+     * Returns 0 on success, CBVH_BACKEND_NONE when no device is present,
+     * CBVH_BACKEND_ERROR on any other failure (err says why, one line). */
+    int (*open)(cbvh_backend *b, const char *arg, char *err, size_t errlen);
+    void (*close)(cbvh_backend *b);
+    /* Runs count vectors of unit: in holds count*n_in words, out receives
+     * count*n_out words.  0 on success, CBVH_BACKEND_ERROR otherwise. */
+    int (*run)(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_config *cfg, const uint32_t *in,
+               uint32_t *out, size_t count, char *err, size_t errlen);
+} cbvh_backend_ops;
+
+enum { CBVH_BACKEND_OK = 0, CBVH_BACKEND_NONE = 1, CBVH_BACKEND_ERROR = 2 };
+
+struct cbvh_backend {
+    const cbvh_backend_ops *ops;
+    void *state;
+    char label[160]; /* human-readable: "model", "usb 1209:c0b1 serial ..." */
+};
+
+extern const cbvh_backend_ops cbvh_backend_model;
+extern const cbvh_backend_ops cbvh_backend_usb;
+extern const cbvh_backend_ops cbvh_backend_hid;
+
+/* Opens by spec: "auto", "model", "usb", "hid" (later "sim:ADDR").  For auto,
+ * writes one line to log when no board is found.  0 on success. */
+int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen);
+void cbvh_backend_close(cbvh_backend *b);
+
+/* USB identity of the board (pid.codes test VID), overridable with the
+ * environment variables CBVH_USB_VID / CBVH_USB_PID (hex). */
+#define CBVH_USB_VID_DEFAULT 0x1209
+#define CBVH_USB_PID_DEFAULT 0xC0B1
+void cbvh_usb_identity(uint16_t *vid, uint16_t *pid);
+
+#endif

@@ -1,0 +1,10 @@
+/* Subcommands of the cbvh tool: one file each (cmd_<name>.c).  Each takes
+ * argc/argv starting at its own name, handles --help, and returns the process
+ * exit status. */
+#ifndef CBVH_HOST_COMMANDS_H
+#define CBVH_HOST_COMMANDS_H
+
+int cmd_vectors(int argc, char **argv); /* cmd_vectors.c: gen | check */
+int cmd_run(int argc, char **argv);     /* cmd_run.c: the main job */
+
+#endif

@@ -1,0 +1,42 @@
+/* cbvh: host tool of the low-precision ray-tracing accelerator kit. */
+#include <stdio.h>
+#include <string.h>
+
+#include "commands.h"
+
+typedef struct {
+    const char *name;
+    int (*fn)(int, char **);
+    const char *summary;
+} command;
+
+static const command commands[] = {
+    {"run", cmd_run, "the main job: check the golden vectors, then an accuracy-vs-time table"},
+    {"vectors", cmd_vectors, "generate (gen) or check (check) golden test vectors"},
+};
+
+static void usage(FILE *f) {
+    fprintf(f, "usage: cbvh <command> [options]   (cbvh <command> --help for each)\n\ncommands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("cbvh %s\n", CBVH_VERSION);
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(argv[1], commands[i].name) == 0) return commands[i].fn(argc - 1, argv + 1);
+    fprintf(stderr, "cbvh: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return 2;
+}

@@ -1,0 +1,56 @@
+/* Integer-only helpers for IEEE-754 binary32 bit patterns.
+ *
+ * Every hardware unit of the model takes and returns binary32 values as bit
+ * patterns (cbvh_f32) and computes with integers only, so its results do not
+ * depend on the host FPU, compiler flags or optimisation level.  The names
+ * follow docs/datapath.md, section "Number formats". */
+#ifndef CBVH_FP32_H
+#define CBVH_FP32_H
+
+#include <stdint.h>
+
+typedef uint32_t cbvh_f32; /* binary32 bit pattern */
+
+#define CBVH_F32_SIGN 0x80000000u
+#define CBVH_F32_EXP 0x7F800000u
+#define CBVH_F32_FRAC 0x007FFFFFu
+#define CBVH_F32_POS_INF 0x7F800000u
+#define CBVH_F32_NEG_INF 0xFF800000u
+#define CBVH_F32_MAX 0x7F7FFFFFu
+
+/* Directed rounding modes of the datapath (no round-to-nearest anywhere). */
+typedef enum { CBVH_RND_DOWN = 0, CBVH_RND_UP = 1 } cbvh_rnd;
+
+static inline int cbvh_f32_is_nan_or_inf(cbvh_f32 b) { return (b & CBVH_F32_EXP) == CBVH_F32_EXP; }
+static inline int cbvh_f32_is_nan(cbvh_f32 b) {
+    return cbvh_f32_is_nan_or_inf(b) && (b & CBVH_F32_FRAC) != 0;
+}
+static inline int cbvh_f32_is_zero(cbvh_f32 b) { return (b & ~CBVH_F32_SIGN) == 0; }
+
+/* break_float: value = (-1)^sign * sig * 2^exp with sig < 2^24 (hidden bit
+ * included for normals; subnormals have exp = -149).  Finite inputs only. */
+void cbvh_f32_break(cbvh_f32 b, int *sign, uint32_t *sig, int *exp);
+
+/* pack_float: round (-1)^neg * mag * 2^exp to binary32 in the given direction.
+ * Overflow follows IEEE-754 directed rounding (to +-Inf away from zero in the
+ * rounding direction, else to +-FLT_MAX).  A zero result is +0. */
+cbvh_f32 cbvh_f32_pack(int neg, uint64_t mag, int exp, cbvh_rnd mode);
+
+/* Exact a*2^ea + b*2^eb (|a|,|b| < 2^25) rounded once in the given direction. */
+cbvh_f32 cbvh_f32_add_dyadic(int64_t a, int ea, int64_t b, int eb, cbvh_rnd mode);
+
+/* Total order of finite values: -1, 0, 1 (+0 == -0). */
+int cbvh_f32_cmp(cbvh_f32 a, cbvh_f32 b);
+
+/* Next binary32 toward +Inf / -Inf (finite inputs; -0 treated as +0). */
+cbvh_f32 cbvh_f32_next_up(cbvh_f32 b);
+cbvh_f32 cbvh_f32_next_down(cbvh_f32 b);
+
+/* Number of significant bits of x (0 for 0). */
+static inline int cbvh_bitlen64(uint64_t x) {
+    int n = 0;
+    while (x) { n++; x >>= 1; }
+    return n;
+}
+
+#endif

@@ -1,0 +1,227 @@
+/* Word-level adapters from the unit table to the units (docs/vectors.md lists
+ * the fields of each unit in this order). */
+#include "cbvh/unit_table.h"
+
+#include <string.h>
+
+static void add(cbvh_field *f, int *n, const char *name, int digits) {
+    f[*n].name = name;
+    f[*n].hex_digits = digits;
+    (*n)++;
+}
+
+#define F32 8
+#define SCALE 2
+#define CODE 3
+#define STATUS 2
+
+/* ---- scale_estimate ---- */
+static void estimate_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    add(l->in, &l->n_in, "lb", F32);
+    add(l->in, &l->n_in, "ub", F32);
+    add(l->out, &l->n_out, "scale", SCALE);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void estimate_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    int e;
+    uint32_t st = cbvh_scale_estimate(&cfg->params, in[0], in[1], &e);
+    out[0] = cbvh_scale_to_word(e);
+    out[1] = st;
+}
+
+/* ---- shared axis-code output ---- */
+static void code_layout(cbvh_layout *l) {
+    add(l->out, &l->n_out, "lb_mod", CODE);
+    add(l->out, &l->n_out, "ub_mod", CODE);
+    add(l->out, &l->n_out, "child_scale", SCALE);
+    add(l->out, &l->n_out, "clb", F32);
+    add(l->out, &l->n_out, "cub", F32);
+}
+static void code_words(const cbvh_axis_code *c, uint32_t *out) {
+    out[0] = c->lb_mod;
+    out[1] = c->ub_mod;
+    out[2] = cbvh_scale_to_word(c->child_scale);
+    out[3] = c->clb;
+    out[4] = c->cub;
+}
+
+/* ---- axis_compress ---- */
+static void compress_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    add(l->in, &l->n_in, "lb", F32);
+    add(l->in, &l->n_in, "ub", F32);
+    add(l->in, &l->n_in, "scale", SCALE);
+    code_layout(l);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void compress_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    cbvh_axis_code c;
+    uint32_t st = cbvh_axis_compress(&cfg->params, in[0], in[1], cbvh_scale_from_word(in[2]), &c);
+    code_words(&c, out);
+    out[5] = st;
+}
+
+/* ---- axis_decode ---- */
+static void ctx_layout(cbvh_layout *l, const char *const names[4]) {
+    add(l->in, &l->n_in, names[0], SCALE);
+    add(l->in, &l->n_in, names[1], SCALE);
+    add(l->in, &l->n_in, names[2], CODE);
+    add(l->in, &l->n_in, names[3], F32);
+}
+static cbvh_axis_ctx ctx_words(const uint32_t *in) {
+    cbvh_axis_ctx c = {cbvh_scale_from_word(in[0]), cbvh_scale_from_word(in[1]), in[2], in[3]};
+    return c;
+}
+static const char *const ctx_names[4] = {"parent_scale", "scale", "node_lb_mod", "node_clb"};
+static void decode_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    ctx_layout(l, ctx_names);
+    add(l->in, &l->n_in, "lb_code", CODE);
+    add(l->in, &l->n_in, "ub_code", CODE);
+    code_layout(l);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void decode_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    cbvh_axis_code c;
+    cbvh_axis_ctx ctx = ctx_words(in);
+    uint32_t st = cbvh_axis_decode(&cfg->params, cfg->enc, &ctx, in[4], in[5], &c);
+    code_words(&c, out);
+    out[5] = st;
+}
+
+/* ---- node pair ---- */
+static const char *const axis_ctx_names[3][4] = {
+    {"x_parent_scale", "x_scale", "x_node_lb_mod", "x_node_clb"},
+    {"y_parent_scale", "y_scale", "y_node_lb_mod", "y_node_clb"},
+    {"z_parent_scale", "z_scale", "z_node_lb_mod", "z_node_clb"},
+};
+static const char *const word_names[6] = {"word0", "word1", "word2", "word3", "word4", "word5"};
+static const char *const child_box_names[2][6] = {
+    {"c0_lo_x", "c0_hi_x", "c0_lo_y", "c0_hi_y", "c0_lo_z", "c0_hi_z"},
+    {"c1_lo_x", "c1_hi_x", "c1_lo_y", "c1_hi_y", "c1_lo_z", "c1_hi_z"},
+};
+static const char *const child_out_names[2][17] = {
+    {"c0_flags", "c0_ptr", "c0_x_lb_mod", "c0_x_ub_mod", "c0_x_child_scale", "c0_x_clb", "c0_x_cub", "c0_y_lb_mod",
+     "c0_y_ub_mod", "c0_y_child_scale", "c0_y_clb", "c0_y_cub", "c0_z_lb_mod", "c0_z_ub_mod", "c0_z_child_scale",
+     "c0_z_clb", "c0_z_cub"},
+    {"c1_flags", "c1_ptr", "c1_x_lb_mod", "c1_x_ub_mod", "c1_x_child_scale", "c1_x_clb", "c1_x_cub", "c1_y_lb_mod",
+     "c1_y_ub_mod", "c1_y_child_scale", "c1_y_clb", "c1_y_cub", "c1_z_lb_mod", "c1_z_ub_mod", "c1_z_child_scale",
+     "c1_z_clb", "c1_z_cub"},
+};
+
+static int pair_words(const cbvh_unit_config *cfg) { return (int)cbvh_nodepair_bytes(cfg->params.quant_bits) / 4; }
+
+static void node_ctx_layout(cbvh_layout *l) {
+    for (int a = 0; a < 3; a++) ctx_layout(l, axis_ctx_names[a]);
+}
+static cbvh_node_ctx node_ctx_words(const uint32_t *in) {
+    cbvh_node_ctx c;
+    for (int a = 0; a < 3; a++) c.axis[a] = ctx_words(in + 4 * a);
+    return c;
+}
+static void words_from_bytes(const uint8_t *b, int n, uint32_t *w) {
+    for (int i = 0; i < n; i++)
+        w[i] = (uint32_t)b[4 * i] | (uint32_t)b[4 * i + 1] << 8 | (uint32_t)b[4 * i + 2] << 16 |
+               (uint32_t)b[4 * i + 3] << 24;
+}
+static void bytes_from_words(const uint32_t *w, int n, uint8_t *b) {
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < 4; j++) b[4 * i + j] = (uint8_t)(w[i] >> (8 * j));
+}
+
+static void encode_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    l->n_in = l->n_out = 0;
+    node_ctx_layout(l);
+    for (int c = 0; c < 2; c++) {
+        for (int i = 0; i < 6; i++) add(l->in, &l->n_in, child_box_names[c][i], F32);
+        add(l->in, &l->n_in, child_out_names[c][0], 1);
+        add(l->in, &l->n_in, child_out_names[c][1], 8);
+    }
+    for (int i = 0; i < pair_words(cfg); i++) add(l->out, &l->n_out, word_names[i], 8);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void encode_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    cbvh_node_ctx ctx = node_ctx_words(in);
+    cbvh_child_in ch[2];
+    for (int c = 0; c < 2; c++) {
+        const uint32_t *w = in + 12 + 8 * c;
+        for (int a = 0; a < 3; a++) {
+            ch[c].lo[a] = w[2 * a];
+            ch[c].hi[a] = w[2 * a + 1];
+        }
+        ch[c].leaf = (int)(w[6] & 1u);
+        ch[c].empty = (int)((w[6] >> 1) & 1u);
+        ch[c].ptr = w[7];
+    }
+    uint8_t bytes[24];
+    cbvh_child_out o[2];
+    uint32_t st = cbvh_nodepair_encode(&cfg->params, cfg->enc, &ctx, ch, bytes, o);
+    int nw = pair_words(cfg);
+    words_from_bytes(bytes, nw, out);
+    out[nw] = st;
+}
+
+static void decode_pair_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    l->n_in = l->n_out = 0;
+    node_ctx_layout(l);
+    for (int i = 0; i < pair_words(cfg); i++) add(l->in, &l->n_in, word_names[i], 8);
+    for (int c = 0; c < 2; c++) {
+        add(l->out, &l->n_out, child_out_names[c][0], 1);
+        add(l->out, &l->n_out, child_out_names[c][1], 8);
+        for (int a = 0; a < 3; a++) {
+            static const int digits[5] = {CODE, CODE, SCALE, F32, F32};
+            for (int i = 0; i < 5; i++) add(l->out, &l->n_out, child_out_names[c][2 + 5 * a + i], digits[i]);
+        }
+    }
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void decode_pair_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    cbvh_node_ctx ctx = node_ctx_words(in);
+    uint8_t bytes[24];
+    int nw = pair_words(cfg);
+    bytes_from_words(in + 12, nw, bytes);
+    cbvh_child_out o[2];
+    uint32_t st = cbvh_nodepair_decode(&cfg->params, cfg->enc, &ctx, bytes, o);
+    uint32_t *w = out;
+    for (int c = 0; c < 2; c++) {
+        *w++ = (uint32_t)o[c].leaf | (uint32_t)o[c].empty << 1;
+        *w++ = o[c].ptr;
+        for (int a = 0; a < 3; a++, w += 5) code_words(&o[c].axis[a], w);
+    }
+    *w = st;
+}
+
+static const cbvh_unit unit_estimate = {"scale_estimate", 1, 0, estimate_layout, estimate_eval};
+static const cbvh_unit unit_compress = {"axis_compress", 2, 0, compress_layout, compress_eval};
+static const cbvh_unit unit_decode = {"axis_decode", 3, 1, decode_layout, decode_eval};
+static const cbvh_unit unit_encode_pair = {"nodepair_encode", 4, 1, encode_layout, encode_eval};
+static const cbvh_unit unit_decode_pair = {"nodepair_decode", 5, 1, decode_pair_layout, decode_pair_eval};
+
+const cbvh_unit *const cbvh_units[] = {&unit_estimate, &unit_compress, &unit_decode, &unit_encode_pair,
+                                       &unit_decode_pair};
+const int cbvh_unit_count = (int)(sizeof cbvh_units / sizeof cbvh_units[0]);
+
+const cbvh_unit *cbvh_unit_find(const char *name) {
+    for (int i = 0; i < cbvh_unit_count; i++)
+        if (strcmp(cbvh_units[i]->name, name) == 0) return cbvh_units[i];
+    return NULL;
+}
+
+const cbvh_unit *cbvh_unit_by_id(int id) {
+    for (int i = 0; i < cbvh_unit_count; i++)
+        if (cbvh_units[i]->id == id) return cbvh_units[i];
+    return NULL;
+}
+
+const char *cbvh_encoding_name(cbvh_encoding e) { return e == CBVH_ENC_RELATIVE ? "relative" : "modulo"; }
+
+int cbvh_encoding_parse(const char *s, cbvh_encoding *e) {
+    if (strcmp(s, "modulo") == 0) *e = CBVH_ENC_MODULO;
+    else if (strcmp(s, "relative") == 0) *e = CBVH_ENC_RELATIVE;
+    else return -1;
+    return 0;
+}
