@@ -25,20 +25,34 @@ static uint32_t ptr_all_ones(int n) {
     return pb >= 32 ? 0xFFFFFFFFu : (1u << pb) - 1u;
 }
 
-static void put_bits(uint8_t *b, int pos, int width, uint32_t v) {
-    for (int i = 0; i < width; i++, pos++) {
-        uint8_t bit = (uint8_t)(1u << (pos & 7));
-        if ((v >> i) & 1u)
-            b[pos >> 3] |= bit;
-        else
-            b[pos >> 3] &= (uint8_t)~bit;
-    }
+/* A node as a little-endian bit string of up to 128 bits: bit i is bit
+ * (i % 8) of byte i / 8.  Loaded into two 64-bit words so that fields are
+ * read and written with shifts, not bit by bit. */
+typedef struct {
+    uint64_t w[2];
+} node_bits;
+
+static node_bits load_node(const uint8_t *b, int nbytes) {
+    node_bits v = {{0, 0}};
+    for (int i = 0; i < nbytes; i++) v.w[i >> 3] |= (uint64_t)b[i] << (8 * (i & 7));
+    return v;
 }
 
-static uint32_t get_bits(const uint8_t *b, int pos, int width) {
-    uint32_t v = 0;
-    for (int i = 0; i < width; i++, pos++) v |= (uint32_t)((b[pos >> 3] >> (pos & 7)) & 1u) << i;
-    return v;
+static void store_node(const node_bits *v, uint8_t *b, int nbytes) {
+    for (int i = 0; i < nbytes; i++) b[i] = (uint8_t)(v->w[i >> 3] >> (8 * (i & 7)));
+}
+
+/* The low `width` (1..32) bits of v into bits [pos, pos + width) (zero before). */
+static void put_bits(node_bits *n, int pos, int width, uint32_t v) {
+    uint64_t x = (uint64_t)v & ((UINT64_C(1) << width) - 1);
+    n->w[pos >> 6] |= x << (pos & 63);
+    if ((pos & 63) + width > 64) n->w[(pos >> 6) + 1] |= x >> (64 - (pos & 63));
+}
+
+static uint32_t get_bits(const node_bits *n, int pos, int width) {
+    uint64_t x = n->w[pos >> 6] >> (pos & 63);
+    if ((pos & 63) + width > 64) x |= n->w[(pos >> 6) + 1] << (64 - (pos & 63));
+    return (uint32_t)(x & ((UINT64_C(1) << width) - 1));
 }
 
 uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
@@ -51,14 +65,20 @@ uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbv
     int w = cbvh_node_bits(n), pb = cbvh_node_ptr_bits(n);
     memset(bytes, 0, nb);
     uint32_t ones = ptr_all_ones(n);
+    /* The context is checked as the decoder checks it, so both directions
+     * reject the same contexts (relative codes depend on parent_scale - scale). */
+    for (int a = 0; a < 3; a++) st |= cbvh_axis_ctx_check(p, &ctx->axis[a]);
+    if (st) return st; /* bytes and outputs are zero */
     for (int c = 0; c < 2; c++) {
-        uint8_t *node = bytes + (size_t)c * (size_t)w / 8u;
+        uint8_t *bytes_c = bytes + (size_t)c * (size_t)w / 8u;
+        node_bits nb_c = {{0, 0}}, *node = &nb_c;
         cbvh_child_out *o = &out[c];
         if (child[c].empty) {
             o->empty = o->leaf = 1;
             o->ptr = ones;
             put_bits(node, 6 * n, 1, 1);
             put_bits(node, 6 * n + 1, pb, ones);
+            store_node(node, bytes_c, w / 8);
             continue;
         }
         if (child[c].leaf ? child[c].ptr >= ones : (pb < 32 && child[c].ptr > ones)) st |= CBVH_ST_BAD_FORMAT;
@@ -74,6 +94,7 @@ uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbv
         }
         put_bits(node, 6 * n, 1, (uint32_t)o->leaf);
         put_bits(node, 6 * n + 1, pb, o->ptr);
+        store_node(node, bytes_c, w / 8);
     }
     if (st & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT)) {
         memset(bytes, 0, nb);
@@ -91,7 +112,7 @@ uint32_t cbvh_nodepair_decode(const cbvh_params *p, cbvh_encoding enc, const cbv
     int w = cbvh_node_bits(n), pb = cbvh_node_ptr_bits(n);
     uint32_t ones = ptr_all_ones(n);
     for (int c = 0; c < 2; c++) {
-        const uint8_t *node = bytes + (size_t)c * (size_t)w / 8u;
+        const node_bits nb_c = load_node(bytes + (size_t)c * (size_t)w / 8u, w / 8), *node = &nb_c;
         cbvh_child_out *o = &out[c];
         for (int pos = 6 * n + 1 + pb; pos < w; pos += 32) {
             int width = w - pos < 32 ? w - pos : 32;

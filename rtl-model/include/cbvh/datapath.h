@@ -81,6 +81,11 @@ uint32_t cbvh_axis_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int 
 uint32_t cbvh_axis_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_axis_ctx *ctx, uint32_t lb_code,
                           uint32_t ub_code, cbvh_axis_code *out);
 
+/* Validates a context: 0, or BAD_SCALE (scale < min_scale, parent_scale > 126,
+ * parent_scale < scale), BAD_CODE (lb_mod >= 2^N), NAN_INF (clb NaN or +Inf;
+ * -Inf encodes -2^128).  The decoder and the node-pair encoder apply it. */
+uint32_t cbvh_axis_ctx_check(const cbvh_params *p, const cbvh_axis_ctx *ctx);
+
 /* Stored codes of a compressed axis in the given encoding (relative: Eq. 1 with
  * s = 2^N stored as 0; modulo: the codes themselves). */
 void cbvh_axis_store_codes(const cbvh_params *p, cbvh_encoding enc, const cbvh_axis_ctx *ctx,

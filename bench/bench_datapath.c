@@ -1,0 +1,268 @@
+/* Datapath benchmark: ns per operation and operations/s of the bit-exact
+ * model's units on a scene-like input mix, against a naive float
+ * implementation of the same quantization measured in the same run.
+ *
+ * usage: bench_datapath [--seconds S] [--seed N]
+ *
+ * Inputs: 4096 child boxes of a random scene (triangle-sized boxes, log-
+ * uniform sizes 2^-8..2^2, scene extent +-64), each inside a parent node box
+ * a few times larger; the parent gives the context (root_ctx).  The same
+ * arrays are cycled, so the working set stays in L1/L2 like a hardware unit's
+ * registers would. */
+#include <getopt.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cbvh/datapath.h"
+
+#define NB 4096 /* boxes per input set (power of two) */
+
+typedef struct {
+    cbvh_f32 lb, ub;      /* child box along one axis */
+    cbvh_axis_ctx ctx;    /* parent context */
+    uint32_t lc[2], uc[2]; /* stored codes: modulo, relative */
+} axis_input;
+
+static axis_input in[NB];
+static cbvh_node_ctx nctx[NB / 8];
+static cbvh_child_in nchild[NB / 8][2];
+static uint8_t nbytes[NB / 8][24];
+static const cbvh_params P = {6, CBVH_MIN_SCALE_DEFAULT};
+
+static uint64_t rng_state;
+static uint64_t rng(void) {
+    uint64_t z = (rng_state += UINT64_C(0x9E3779B97F4A7C15));
+    z = (z ^ (z >> 30)) * UINT64_C(0xBF58476D1CE4E5B9);
+    z = (z ^ (z >> 27)) * UINT64_C(0x94D049BB133111EB);
+    return z ^ (z >> 31);
+}
+static double unit(void) { return (double)(rng() >> 11) * 0x1p-53; }
+static float b2f(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, 4);
+    return f;
+}
+static cbvh_f32 f2b(float f) {
+    cbvh_f32 b;
+    memcpy(&b, &f, 4);
+    return b;
+}
+
+static void make_inputs(void) {
+    for (int i = 0; i < NB; i++) {
+        axis_input *x = &in[i];
+        float centre = (float)(unit() * 128.0 - 64.0);
+        float size = (float)ldexp(1.0, -8 + (int)(rng() % 10)) * (float)(0.5 + unit());
+        if (rng() % 16 == 0) size = 0.0f; /* flat triangles (axis-aligned) */
+        float lb = centre - (float)unit() * size, ub = lb + size;
+        float grow = (float)ldexp(1.0, (int)(rng() % 6)); /* parent 1x..32x the child */
+        float plb = lb - (float)unit() * size * grow - 1e-3f, pub = ub + (float)unit() * size * grow + 1e-3f;
+        x->lb = f2b(lb);
+        x->ub = f2b(ub);
+        if (cbvh_axis_root_ctx(&P, f2b(plb), f2b(pub), &x->ctx)) abort();
+        cbvh_axis_code c;
+        if (cbvh_axis_compress(&P, x->lb, x->ub, x->ctx.scale, &c)) abort();
+        for (int enc = 0; enc < 2; enc++)
+            cbvh_axis_store_codes(&P, (cbvh_encoding)enc, &x->ctx, &c, &x->lc[enc], &x->uc[enc]);
+    }
+    for (int i = 0; i < NB / 8; i++) {
+        for (int c = 0; c < 2; c++) {
+            for (int a = 0; a < 3; a++) {
+                const axis_input *x = &in[(i * 6 + c * 3 + a) % NB];
+                nchild[i][c].lo[a] = x->lb;
+                nchild[i][c].hi[a] = x->ub;
+            }
+            nchild[i][c].leaf = c;
+            nchild[i][c].ptr = (uint32_t)(rng() % 100000);
+        }
+        /* one context per pair: the union of the two children grown a bit */
+        for (int a = 0; a < 3; a++) {
+            float lo = fminf(b2f(nchild[i][0].lo[a]), b2f(nchild[i][1].lo[a])) - 0.01f;
+            float hi = fmaxf(b2f(nchild[i][0].hi[a]), b2f(nchild[i][1].hi[a])) + 0.01f;
+            if (cbvh_axis_root_ctx(&P, f2b(lo), f2b(hi), &nctx[i].axis[a])) abort();
+        }
+        cbvh_child_out out[2];
+        if (cbvh_nodepair_encode(&P, CBVH_ENC_MODULO, &nctx[i], nchild[i], nbytes[i], out)) abort();
+    }
+}
+
+/* ---- naive float baselines (not bit-exact: float ops, round to nearest) ---- */
+typedef struct {
+    uint32_t lb_mod, ub_mod;
+    int child_scale;
+    float clb, cub;
+} naive_code;
+
+static void naive_compress_ldexpf(int n, int min_scale, float lb, float ub, int e, naive_code *o) {
+    float k = floorf(ldexpf(lb, -e)), l = floorf(ldexpf(ub, -e)) + 1.0f;
+    int32_t ki = (int32_t)k, li = (int32_t)l;
+    uint32_t mask = (1u << n) - 1u;
+    o->lb_mod = (uint32_t)ki & mask;
+    o->ub_mod = (uint32_t)li & mask;
+    int cs = e - n + ilogbf((float)(li - ki - 1) * 2.0f + 1.0f); /* ~ceil(log2(cells)) */
+    o->child_scale = cs < min_scale ? min_scale : cs;
+    o->clb = ldexpf(k, e);
+    o->cub = ldexpf(l, e);
+}
+
+/* 2^x as a float built from its bits (|x| <= 126) */
+static float pow2f(int x) { return b2f((cbvh_f32)(x + 127) << 23); }
+
+static void naive_compress_mul(int n, int min_scale, float lb, float ub, int e, naive_code *o) {
+    float inv = pow2f(-e), step = pow2f(e);
+    float k = floorf(lb * inv), l = floorf(ub * inv) + 1.0f;
+    int32_t ki = (int32_t)k, li = (int32_t)l;
+    uint32_t mask = (1u << n) - 1u;
+    o->lb_mod = (uint32_t)ki & mask;
+    o->ub_mod = (uint32_t)li & mask;
+    uint32_t cells = (uint32_t)(li - ki);
+    int cs = e - n + (cells > 1 ? 32 - __builtin_clz(cells - 1u) : 0);
+    o->child_scale = cs < min_scale ? min_scale : cs;
+    o->clb = k * step;
+    o->cub = l * step;
+}
+
+static void naive_decode(int n, int min_scale, const cbvh_axis_ctx *ctx, uint32_t lc, uint32_t uc, naive_code *o) {
+    uint32_t mask = (1u << n) - 1u;
+    int sh = ctx->parent_scale - ctx->scale;
+    uint32_t pmod = sh >= n ? 0 : (ctx->lb_mod << sh) & mask;
+    uint32_t r = (lc - pmod) & mask, s = (uc - pmod) & mask;
+    if (s == 0) s = mask + 1u;
+    float step = pow2f(ctx->scale), u = b2f(ctx->clb);
+    o->lb_mod = lc;
+    o->ub_mod = uc;
+    int cs = ctx->scale - n + (s - r > 1 ? 32 - __builtin_clz(s - r - 1u) : 0);
+    o->child_scale = cs < min_scale ? min_scale : cs;
+    o->clb = u + (float)r * step;
+    o->cub = u + (float)s * step;
+}
+
+/* ---- timing ---- */
+static double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static volatile uint32_t sink;
+static double min_seconds = 0.2;
+
+#define SINK_CODE(c) ((c).lb_mod ^ (c).ub_mod ^ (uint32_t)(c).child_scale ^ (c).clb ^ (c).cub)
+
+/* Runs BODY over all NB inputs repeatedly for >= min_seconds, best of 5 runs
+ * (the best run is the one least disturbed by other processes);
+ * returns ns per operation (ops_per_input operations per input). */
+#define TIME_LOOP(result, ops_per_input, count, BODY)                                                                  \
+    do {                                                                                                               \
+        double best = 1e30;                                                                                            \
+        for (int run = 0; run < 5; run++) {                                                                            \
+            long reps = 0;                                                                                             \
+            uint32_t acc = 0;                                                                                          \
+            double t0 = now(), t1;                                                                                     \
+            do {                                                                                                       \
+                for (int i = 0; i < (count); i++) { BODY }                                                             \
+                reps++;                                                                                                \
+            } while ((t1 = now()) - t0 < min_seconds);                                                                 \
+            sink ^= acc;                                                                                               \
+            double ns = (t1 - t0) * 1e9 / ((double)reps * (count) * (ops_per_input));                                  \
+            if (ns < best) best = ns;                                                                                  \
+        }                                                                                                              \
+        result = best;                                                                                                 \
+    } while (0)
+
+static void row(const char *name, double ns, double base_ns, const char *base) {
+    printf("%-28s %9.2f %12.1f", name, ns, 1e3 / ns);
+    if (base_ns > 0)
+        printf("   %-22s %8.2f   %6.2fx\n", base, base_ns, ns / base_ns);
+    else
+        printf("\n");
+}
+
+int main(int argc, char **argv) {
+    uint64_t seed = 1;
+    static const struct option opts[] = {{"seconds", required_argument, 0, 't'}, {"seed", required_argument, 0, 's'}, {0, 0, 0, 0}};
+    int ch;
+    while ((ch = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+        char *end;
+        if (ch == 't') {
+            min_seconds = strtod(optarg, &end);
+            if (*end || !(min_seconds > 0)) { fprintf(stderr, "error: --seconds needs a positive number\n"); return 2; }
+        } else if (ch == 's') {
+            seed = strtoull(optarg, &end, 0);
+            if (*end) { fprintf(stderr, "error: --seed needs an integer\n"); return 2; }
+        } else {
+            fprintf(stderr, "usage: %s [--seconds S] [--seed N]\n", argv[0]);
+            return 2;
+        }
+    }
+    rng_state = seed;
+    make_inputs();
+
+    double t_comp, t_dmod, t_drel, t_est, t_enc, t_dec, t_nl, t_nm, t_nd;
+    TIME_LOOP(t_comp, 1, NB, {
+        cbvh_axis_code c;
+        acc += cbvh_axis_compress(&P, in[i].lb, in[i].ub, in[i].ctx.scale, &c);
+        acc += SINK_CODE(c);
+    });
+    TIME_LOOP(t_nl, 1, NB, {
+        naive_code c;
+        naive_compress_ldexpf(P.quant_bits, P.min_scale, b2f(in[i].lb), b2f(in[i].ub), in[i].ctx.scale, &c);
+        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ f2b(c.clb) ^ f2b(c.cub);
+    });
+    TIME_LOOP(t_nm, 1, NB, {
+        naive_code c;
+        naive_compress_mul(P.quant_bits, P.min_scale, b2f(in[i].lb), b2f(in[i].ub), in[i].ctx.scale, &c);
+        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ f2b(c.clb) ^ f2b(c.cub);
+    });
+    TIME_LOOP(t_dmod, 1, NB, {
+        cbvh_axis_code c;
+        acc += cbvh_axis_decode(&P, CBVH_ENC_MODULO, &in[i].ctx, in[i].lc[0], in[i].uc[0], &c);
+        acc += SINK_CODE(c);
+    });
+    TIME_LOOP(t_drel, 1, NB, {
+        cbvh_axis_code c;
+        acc += cbvh_axis_decode(&P, CBVH_ENC_RELATIVE, &in[i].ctx, in[i].lc[1], in[i].uc[1], &c);
+        acc += SINK_CODE(c);
+    });
+    TIME_LOOP(t_nd, 1, NB, {
+        naive_code c;
+        naive_decode(P.quant_bits, P.min_scale, &in[i].ctx, in[i].lc[0], in[i].uc[0], &c);
+        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ f2b(c.clb) ^ f2b(c.cub);
+    });
+    TIME_LOOP(t_est, 1, NB, {
+        int e;
+        acc += cbvh_scale_estimate(&P, in[i].lb, in[i].ub, &e);
+        acc += (uint32_t)e;
+    });
+    TIME_LOOP(t_enc, 1, NB / 8, {
+        cbvh_child_out out[2];
+        uint8_t bytes[24];
+        acc += cbvh_nodepair_encode(&P, CBVH_ENC_MODULO, &nctx[i], nchild[i], bytes, out);
+        acc += bytes[3] ^ out[1].axis[2].cub;
+    });
+    TIME_LOOP(t_dec, 1, NB / 8, {
+        cbvh_child_out out[2];
+        acc += cbvh_nodepair_decode(&P, CBVH_ENC_MODULO, &nctx[i], nbytes[i], out);
+        acc += out[1].axis[2].cub;
+    });
+
+    printf("cbvh datapath benchmark: N=%d, min_scale=%d, %d scene-like boxes, best of 5 x >= %.2f s\n", P.quant_bits,
+           P.min_scale, NB, min_seconds);
+    printf("ratio = model ns/op / baseline ns/op (below 1: the bit-exact model is faster)\n");
+    printf("%-28s %9s %12s   %-22s %8s   %7s\n", "unit", "ns/op", "Mops/s", "baseline (naive float)", "ns/op",
+           "ratio");
+    row("axis_compress", t_comp, t_nl, "floorf+ldexpf");
+    row("", t_comp, t_nm, "floorf+mul by 2^-e");
+    row("axis_decode (modulo)", t_dmod, t_nd, "float add (modulo)");
+    row("axis_decode (relative)", t_drel, t_nd, "float add (modulo)");
+    row("scale_estimate", t_est, 0, "");
+    row("nodepair_encode (pair)", t_enc, 0, "");
+    row("nodepair_decode (pair)", t_dec, 0, "");
+    printf("target: >= 100 Mops/s single-axis compressions on one core: %s (%.1f Mops/s)\n",
+           1e3 / t_comp >= 100.0 ? "MET" : "NOT MET", 1e3 / t_comp);
+    return 0;
+}

@@ -1,0 +1,15 @@
+# cmake -DA=file -DB=file -P compare_digests.cmake: fail unless both digest
+# files exist and are identical.
+foreach(f ${A} ${B})
+    if(NOT EXISTS ${f})
+        message(FATAL_ERROR "digest file missing: ${f}")
+    endif()
+endforeach()
+file(READ ${A} da)
+file(READ ${B} db)
+string(STRIP "${da}" da)
+string(STRIP "${db}" db)
+if(NOT da STREQUAL db)
+    message(FATAL_ERROR "determinism broken: -O0 digest ${da} != -O2 digest ${db}")
+endif()
+message(STATUS "digests agree: ${da}")
