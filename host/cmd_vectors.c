@@ -1,3 +1,283 @@
-#include "commands.h"
+/* cbvh vectors gen | check  (docs/vectors.md) */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <limits.h>
 #include <stdio.h>
-int cmd_vectors(int argc, char **argv) { (void)argc; (void)argv; fprintf(stderr, "cbvh vectors: not written yet\n"); return 2; }
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "manifest.h"
+#include "vecfile.h"
+#include "vecgen.h"
+#include "vectors_check.h"
+
+static void usage_vectors(FILE *f) {
+    fprintf(f, "usage: cbvh vectors <gen|check> [options]   (cbvh vectors <gen|check> --help)\n\n"
+               "  gen    write golden vector files (inputs + model outputs) and DIR/MANIFEST\n"
+               "  check  verify DIR/MANIFEST, run every vector on a backend, report mismatches\n"
+               "\nExit status: 0 all pass, 1 mismatches, 2 bad input. Format: docs/vectors.md\n");
+}
+
+static void usage_gen(FILE *f) {
+    fprintf(f,
+            "usage: cbvh vectors gen [options] -o DIR\n\n"
+            "Writes one file per unit and parameter set (e.g. axis_decode-N6-ms-30-modulo.vec) and\n"
+            "adds/updates their SHA-256 lines in DIR/MANIFEST. Without --unit/--bits/--min-scale it\n"
+            "writes the default set: every datapath unit x N=3..10 x both encodings (where the unit\n"
+            "has one), min_scale -30, plus N=6 with min_scale -126 and -10 for the axis units; the\n"
+            "ray units (ray_box, ray_triangle), which do not depend on N, get one file each (N=6).\n\n"
+            "  -u, --unit U           one unit (");
+    for (int i = 0; i < cbvh_unit_count; i++) fprintf(f, "%s%s", i ? ", " : "", cbvh_units[i]->name);
+    fprintf(f, ")\n"
+               "  -l, --level 1|2        1: structured corner cases (default); 2: plus %d random vectors per file\n"
+               "  -s, --seed S           generator seed, hex or decimal (default 0x%016" PRIX64 ")\n"
+               "  -n, --bits N           coordinate bits, %d..%d (default: all)\n"
+               "  -m, --min-scale E      minimum scale, %d..%d (default %d)\n"
+               "  -e, --encoding E       modulo or relative (default: both)\n"
+               "  -o, --output DIR       output directory (created if missing)\n"
+               "  -h, --help             this text\n",
+            CBVH_VECGEN_LEVEL2_RANDOM, CBVH_VECGEN_DEFAULT_SEED, CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR,
+            CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
+}
+
+static void usage_check(FILE *f) {
+    fprintf(f, "usage: cbvh vectors check [options] DIR|FILE...\n\n"
+               "For a directory, verifies DIR/MANIFEST first (every listed file present with a matching\n"
+               "SHA-256, no unlisted .vec file), then runs every vector on the backend in batches of %d\n"
+               "and prints 'N passed, M failed' per file, a total with the rate, and the first mismatches.\n\n"
+               "  -b, --backend B        auto (default: board if found, else the model), model, usb, hid\n"
+               "  -M, --max-errors K     mismatches shown in full (default 20)\n"
+               "  -j, --json             one JSON object instead of text\n"
+               "  -q, --quiet            no per-file lines for files that pass\n"
+               "  -h, --help             this text\n"
+               "\nExit status: 0 all pass, 1 mismatches, 2 bad input (unknown unit, bad header, bad hex,\n"
+               "wrong field count, hash mismatch, missing file...).\n",
+            CBVH_CHECK_BATCH);
+}
+
+static int parse_long(const char *s, int base, long lo, long hi, long *v) {
+    char *end;
+    errno = 0;
+    long x = strtol(s, &end, base);
+    if (errno || end == s || *end || x < lo || x > hi) return -1;
+    *v = x;
+    return 0;
+}
+
+/* Writes one file through a temp file + rename; returns its SHA-256. */
+static int write_vecfile(const char *dir, const char *name, const cbvh_vecfile *vf, char *hex, char *err,
+                         size_t errlen) {
+    char path[4096], tmp[4200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&buf, &len);
+    if (!mem) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    int bad = cbvh_vecfile_write(mem, vf);
+    bad |= fclose(mem) != 0;
+    if (bad || cbvh_sha256_hex(buf, len, hex) != 0) {
+        free(buf);
+        snprintf(err, errlen, "%.900s: internal error formatting vectors", path);
+        return -1;
+    }
+    FILE *f = fopen(tmp, "wb");
+    if (!f) {
+        free(buf);
+        snprintf(err, errlen, "%.900s: cannot create: %s", tmp, strerror(errno));
+        return -1;
+    }
+    bad = fwrite(buf, 1, len, f) != len;
+    bad |= fclose(f) != 0;
+    free(buf);
+    if (bad || rename(tmp, path) != 0) {
+        snprintf(err, errlen, "%.900s: cannot write: %s", path, strerror(errno));
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+static int cmd_gen(int argc, char **argv) {
+    static const struct option lo[] = {
+        {"unit", required_argument, 0, 'u'},   {"level", required_argument, 0, 'l'},
+        {"seed", required_argument, 0, 's'},   {"bits", required_argument, 0, 'n'},
+        {"min-scale", required_argument, 0, 'm'}, {"encoding", required_argument, 0, 'e'},
+        {"output", required_argument, 0, 'o'}, {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    cbvh_vecgen_select sel;
+    memset(&sel, 0, sizeof sel);
+    sel.level = 1;
+    sel.seed = CBVH_VECGEN_DEFAULT_SEED;
+    const char *dir = NULL;
+    int c;
+    long v;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "u:l:s:n:m:e:o:h", lo, NULL)) != -1) {
+        switch (c) {
+        case 'u':
+            if (!(sel.unit = cbvh_unit_find(optarg))) {
+                fprintf(stderr, "cbvh vectors gen: unknown unit '%s' (cbvh vectors gen --help lists them)\n", optarg);
+                return 2;
+            }
+            break;
+        case 'l':
+            if (parse_long(optarg, 10, 1, 2, &v)) {
+                fprintf(stderr, "cbvh vectors gen: --level must be 1 or 2, not '%s'\n", optarg);
+                return 2;
+            }
+            sel.level = (int)v;
+            break;
+        case 's': {
+            char *end;
+            errno = 0;
+            unsigned long long s = strtoull(optarg, &end, 0);
+            if (errno || end == optarg || *end || optarg[0] == '-') {
+                fprintf(stderr, "cbvh vectors gen: --seed '%s' is not a 64-bit number\n", optarg);
+                return 2;
+            }
+            sel.seed = (uint64_t)s;
+            break;
+        }
+        case 'n':
+            if (parse_long(optarg, 10, CBVH_N_MIN, CBVH_N_MAX, &v)) {
+                fprintf(stderr, "cbvh vectors gen: --bits must be %d..%d, not '%s'\n", CBVH_N_MIN, CBVH_N_MAX, optarg);
+                return 2;
+            }
+            sel.bits = (int)v;
+            break;
+        case 'm':
+            if (parse_long(optarg, 10, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &v)) {
+                fprintf(stderr, "cbvh vectors gen: --min-scale must be %d..%d, not '%s'\n", CBVH_SCALE_FLOOR,
+                        CBVH_SCALE_CEIL, optarg);
+                return 2;
+            }
+            sel.ms_given = 1;
+            sel.min_scale = (int)v;
+            break;
+        case 'e':
+            if (cbvh_encoding_parse(optarg, &sel.enc) != 0) {
+                fprintf(stderr, "cbvh vectors gen: --encoding must be modulo or relative, not '%s'\n", optarg);
+                return 2;
+            }
+            sel.enc_given = 1;
+            break;
+        case 'o': dir = optarg; break;
+        case 'h': usage_gen(stdout); return 0;
+        default: usage_gen(stderr); return 2;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "cbvh vectors gen: unexpected argument '%s'\n", argv[optind]);
+        return 2;
+    }
+    if (!dir) {
+        fprintf(stderr, "cbvh vectors gen: missing -o DIR\n");
+        return 2;
+    }
+    if (sel.unit && sel.enc_given && !sel.unit->uses_encoding) {
+        fprintf(stderr, "cbvh vectors gen: unit %s has no encoding; drop --encoding\n", sel.unit->name);
+        return 2;
+    }
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "cbvh vectors gen: cannot create %s: %s\n", dir, strerror(errno));
+        return 2;
+    }
+    size_t n = cbvh_vecgen_specs(&sel, NULL, 0);
+    cbvh_vecgen_spec *specs = calloc(n ? n : 1, sizeof *specs);
+    if (!specs) return 2;
+    cbvh_vecgen_specs(&sel, specs, n);
+
+    char err[1024];
+    cbvh_manifest m;
+    int mrc = cbvh_manifest_load(dir, &m, err, sizeof err);
+    if (mrc < 0) {
+        fprintf(stderr, "cbvh vectors gen: %s (fix or delete it)\n", err);
+        free(specs);
+        return 2;
+    }
+    size_t total = 0;
+    int rc = 0;
+    for (size_t i = 0; i < n && rc == 0; i++) {
+        char name[256], hex[CBVH_SHA256_HEX_LEN + 1];
+        cbvh_vecgen_filename(&specs[i], name, sizeof name);
+        cbvh_vecfile vf;
+        if (cbvh_vecgen_generate(&specs[i], &vf) != 0) {
+            fprintf(stderr, "cbvh vectors gen: %s: out of memory\n", name);
+            rc = 2;
+            break;
+        }
+        if (write_vecfile(dir, name, &vf, hex, err, sizeof err) != 0 || cbvh_manifest_set(&m, name, hex) != 0) {
+            fprintf(stderr, "cbvh vectors gen: %s\n", err);
+            rc = 2;
+        }
+        total += vf.count;
+        cbvh_vecfile_free(&vf);
+    }
+    /* The manifest vouches for what was written; entries of other files stay. */
+    if (cbvh_manifest_save(dir, &m, err, sizeof err) != 0) {
+        fprintf(stderr, "cbvh vectors gen: %s\n", err);
+        rc = 2;
+    }
+    if (rc == 0) printf("wrote %zu files, %zu vectors, to %s (MANIFEST updated)\n", n, total, dir);
+    cbvh_manifest_free(&m);
+    free(specs);
+    return rc;
+}
+
+static int cmd_check(int argc, char **argv) {
+    static const struct option lo[] = {{"backend", required_argument, 0, 'b'}, {"max-errors", required_argument, 0, 'M'},
+                                       {"json", no_argument, 0, 'j'},         {"quiet", no_argument, 0, 'q'},
+                                       {"help", no_argument, 0, 'h'},         {0, 0, 0, 0}};
+    cbvh_check_opts o;
+    memset(&o, 0, sizeof o);
+    o.backend = "auto";
+    o.max_errors = 20;
+    int c;
+    long v;
+    optind = 0;
+    while ((c = getopt_long(argc, argv, "b:M:jqh", lo, NULL)) != -1) {
+        switch (c) {
+        case 'b': o.backend = optarg; break;
+        case 'M':
+            if (parse_long(optarg, 10, 0, INT_MAX, &v)) {
+                fprintf(stderr, "cbvh vectors check: --max-errors must be a count >= 0, not '%s'\n", optarg);
+                return 2;
+            }
+            o.max_errors = (int)v;
+            break;
+        case 'j': o.json = 1; break;
+        case 'q': o.quiet = 1; break;
+        case 'h': usage_check(stdout); return 0;
+        default: usage_check(stderr); return 2;
+        }
+    }
+    if (optind >= argc) {
+        fprintf(stderr, "cbvh vectors check: give a vector directory or file (e.g. vectors/)\n");
+        return 2;
+    }
+    return cbvh_vectors_check((const char *const *)argv + optind, argc - optind, &o);
+}
+
+int cmd_vectors(int argc, char **argv) {
+    if (argc < 2) {
+        usage_vectors(stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        usage_vectors(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "gen") == 0) return cmd_gen(argc - 1, argv + 1);
+    if (strcmp(argv[1], "check") == 0) return cmd_check(argc - 1, argv + 1);
+    fprintf(stderr, "cbvh vectors: unknown subcommand '%s' (gen or check)\n", argv[1]);
+    usage_vectors(stderr);
+    return 2;
+}

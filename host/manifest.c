@@ -1,0 +1,214 @@
+/* DIR/MANIFEST of the vector files: SHA-256 per file (libcrypto EVP). */
+#include "manifest.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <openssl/evp.h>
+
+#include "vecfile.h"
+
+int cbvh_sha256_hex(const void *buf, size_t len, char hex[CBVH_SHA256_HEX_LEN + 1]) {
+    unsigned char md[EVP_MAX_MD_SIZE];
+    unsigned int mdlen = 0;
+    EVP_MD_CTX *ctx = EVP_MD_CTX_new();
+    int ok = ctx && EVP_DigestInit_ex(ctx, EVP_sha256(), NULL) == 1 && EVP_DigestUpdate(ctx, buf, len) == 1 &&
+             EVP_DigestFinal_ex(ctx, md, &mdlen) == 1 && mdlen == 32;
+    EVP_MD_CTX_free(ctx);
+    if (!ok) return -1;
+    for (unsigned i = 0; i < 32; i++) snprintf(hex + 2 * i, 3, "%02x", md[i]);
+    return 0;
+}
+
+int cbvh_manifest_name_ok(const char *name, size_t n) {
+    if (n == 0 || n > CBVH_MANIFEST_MAX_NAME || name[0] == '.') return 0;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)name[i];
+        if (c <= 0x20 || c >= 0x7F || c == '/' || c == '\\') return 0;
+    }
+    return 1;
+}
+
+void cbvh_manifest_free(cbvh_manifest *m) {
+    free(m->e);
+    m->e = NULL;
+    m->n = m->cap = 0;
+}
+
+const cbvh_manifest_entry *cbvh_manifest_find(const cbvh_manifest *m, const char *name) {
+    for (size_t i = 0; i < m->n; i++)
+        if (strcmp(m->e[i].name, name) == 0) return &m->e[i];
+    return NULL;
+}
+
+int cbvh_manifest_set(cbvh_manifest *m, const char *name, const char *sha256) {
+    size_t n = strlen(name);
+    if (!cbvh_manifest_name_ok(name, n) || strlen(sha256) != CBVH_SHA256_HEX_LEN) return -1;
+    cbvh_manifest_entry *e = (cbvh_manifest_entry *)cbvh_manifest_find(m, name);
+    if (!e) {
+        if (m->n == m->cap) {
+            size_t cap = m->cap ? m->cap * 2 : 64;
+            cbvh_manifest_entry *ne = realloc(m->e, cap * sizeof *ne);
+            if (!ne) return -1;
+            m->e = ne;
+            m->cap = cap;
+        }
+        e = &m->e[m->n++];
+        memcpy(e->name, name, n + 1);
+    }
+    memcpy(e->sha256, sha256, CBVH_SHA256_HEX_LEN + 1);
+    return 0;
+}
+
+int cbvh_manifest_parse(const char *buf, size_t len, const char *name, cbvh_manifest *m, char *err, size_t errlen) {
+    memset(m, 0, sizeof *m);
+    size_t pos = 0, line = 0;
+    while (pos < len) {
+        line++;
+        const char *s = buf + pos;
+        const char *nl = memchr(s, '\n', len - pos);
+        if (!nl) {
+            snprintf(err, errlen, "%s:%zu: last line has no newline (truncated file?)", name, line);
+            goto bad;
+        }
+        size_t n = (size_t)(nl - s);
+        pos += n + 1;
+        int hex_ok = n > CBVH_SHA256_HEX_LEN + 2 && s[CBVH_SHA256_HEX_LEN] == ' ' && s[CBVH_SHA256_HEX_LEN + 1] == ' ';
+        for (size_t i = 0; hex_ok && i < CBVH_SHA256_HEX_LEN; i++)
+            hex_ok = (s[i] >= '0' && s[i] <= '9') || (s[i] >= 'a' && s[i] <= 'f');
+        if (!hex_ok) {
+            snprintf(err, errlen, "%s:%zu: malformed line (expected '<64 lower-case hex digits>  <file name>')", name,
+                     line);
+            goto bad;
+        }
+        const char *fn = s + CBVH_SHA256_HEX_LEN + 2;
+        size_t fnn = n - CBVH_SHA256_HEX_LEN - 2;
+        if (!cbvh_manifest_name_ok(fn, fnn)) {
+            snprintf(err, errlen, "%s:%zu: bad file name (plain printable names without '/' only)", name, line);
+            goto bad;
+        }
+        char fname[CBVH_MANIFEST_MAX_NAME + 1], hex[CBVH_SHA256_HEX_LEN + 1];
+        memcpy(fname, fn, fnn);
+        fname[fnn] = '\0';
+        memcpy(hex, s, CBVH_SHA256_HEX_LEN);
+        hex[CBVH_SHA256_HEX_LEN] = '\0';
+        if (cbvh_manifest_find(m, fname)) {
+            snprintf(err, errlen, "%s:%zu: %s is listed twice", name, line, fname);
+            goto bad;
+        }
+        if (cbvh_manifest_set(m, fname, hex) != 0) {
+            snprintf(err, errlen, "%s:%zu: out of memory", name, line);
+            goto bad;
+        }
+    }
+    return 0;
+bad:
+    cbvh_manifest_free(m);
+    return -1;
+}
+
+static void join(char *dst, size_t n, const char *dir, const char *name) { snprintf(dst, n, "%s/%s", dir, name); }
+
+int cbvh_manifest_load(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    memset(m, 0, sizeof *m);
+    char path[4096];
+    join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
+    if (access(path, F_OK) != 0 && errno == ENOENT) return 1;
+    char *buf;
+    size_t len;
+    if (cbvh_read_file(path, &buf, &len, err, errlen) != 0) return -1;
+    int rc = cbvh_manifest_parse(buf, len, path, m, err, errlen);
+    free(buf);
+    return rc;
+}
+
+static int by_name(const void *a, const void *b) {
+    return strcmp(((const cbvh_manifest_entry *)a)->name, ((const cbvh_manifest_entry *)b)->name);
+}
+
+int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    if (m->n) qsort(m->e, m->n, sizeof *m->e, by_name);
+    char path[4096], tmp[4200];
+    join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
+    snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%ld", dir, CBVH_MANIFEST_NAME, (long)getpid());
+    FILE *f = fopen(tmp, "wb");
+    if (!f) {
+        snprintf(err, errlen, "%s: cannot create: %s", tmp, strerror(errno));
+        return -1;
+    }
+    for (size_t i = 0; i < m->n; i++) fprintf(f, "%s  %s\n", m->e[i].sha256, m->e[i].name);
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+static int ends_with(const char *s, const char *suffix) {
+    size_t n = strlen(s), k = strlen(suffix);
+    return n >= k && strcmp(s + n - k, suffix) == 0;
+}
+
+int cbvh_manifest_verify_dir(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    char path[4096];
+    int rc = cbvh_manifest_load(dir, m, err, errlen);
+    if (rc == 1) {
+        join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
+        snprintf(err, errlen, "%s: missing (every vector directory needs a MANIFEST)", path);
+        return -1;
+    }
+    if (rc != 0) return -1;
+    if (m->n == 0) {
+        join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
+        snprintf(err, errlen, "%s: lists no files", path);
+        goto bad;
+    }
+    for (size_t i = 0; i < m->n; i++) {
+        join(path, sizeof path, dir, m->e[i].name);
+        char *buf;
+        size_t len;
+        char why[512];
+        if (cbvh_read_file(path, &buf, &len, why, sizeof why) != 0) {
+            snprintf(err, errlen, "%s (listed in MANIFEST)", why);
+            goto bad;
+        }
+        char hex[CBVH_SHA256_HEX_LEN + 1];
+        int hrc = cbvh_sha256_hex(buf, len, hex);
+        free(buf);
+        if (hrc != 0) {
+            snprintf(err, errlen, "%s: SHA-256 failed (libcrypto)", path);
+            goto bad;
+        }
+        if (strcmp(hex, m->e[i].sha256) != 0) {
+            snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path,
+                     m->e[i].sha256, hex);
+            goto bad;
+        }
+    }
+    DIR *d = opendir(dir);
+    if (!d) {
+        snprintf(err, errlen, "%s: cannot list directory: %s", dir, strerror(errno));
+        goto bad;
+    }
+    struct dirent *de;
+    while ((de = readdir(d)) != NULL) {
+        if (de->d_name[0] != '.' && ends_with(de->d_name, ".vec") && !cbvh_manifest_find(m, de->d_name)) {
+            join(path, sizeof path, dir, de->d_name);
+            snprintf(err, errlen, "%s: vector file not listed in MANIFEST", path);
+            closedir(d);
+            goto bad;
+        }
+    }
+    closedir(d);
+    return 0;
+bad:
+    cbvh_manifest_free(m);
+    return -1;
+}

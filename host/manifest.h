@@ -1,0 +1,53 @@
+/* DIR/MANIFEST: the SHA-256 of every vector file (libvpx test-vector style).
+ * One line per file, sorted by name, in sha256sum's format so that
+ * `cd DIR && sha256sum -c MANIFEST` also works:
+ *     <64 lower-case hex digits><two spaces><file name> */
+#ifndef CBVH_HOST_MANIFEST_H
+#define CBVH_HOST_MANIFEST_H
+
+#include <stddef.h>
+
+#define CBVH_MANIFEST_NAME "MANIFEST"
+#define CBVH_SHA256_HEX_LEN 64
+#define CBVH_MANIFEST_MAX_NAME 200
+
+typedef struct {
+    char name[CBVH_MANIFEST_MAX_NAME + 1];
+    char sha256[CBVH_SHA256_HEX_LEN + 1];
+} cbvh_manifest_entry;
+
+typedef struct {
+    cbvh_manifest_entry *e;
+    size_t n, cap;
+} cbvh_manifest;
+
+/* SHA-256 of a buffer as lower-case hex (libcrypto EVP).  0 or -1. */
+int cbvh_sha256_hex(const void *buf, size_t len, char hex[CBVH_SHA256_HEX_LEN + 1]);
+
+/* Strict parse of a manifest held in memory; name is used in messages
+ * ("name:line: what").  0 or -1 with err set; m is empty on error. */
+int cbvh_manifest_parse(const char *buf, size_t len, const char *name, cbvh_manifest *m, char *err, size_t errlen);
+
+/* Loads DIR/MANIFEST.  Returns 0, 1 when the file does not exist (m empty),
+ * -1 on any other error (err set). */
+int cbvh_manifest_load(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
+
+const cbvh_manifest_entry *cbvh_manifest_find(const cbvh_manifest *m, const char *name);
+
+/* Adds or replaces the entry for name.  0 or -1 (bad name / no memory). */
+int cbvh_manifest_set(cbvh_manifest *m, const char *name, const char *sha256);
+
+/* Writes DIR/MANIFEST sorted by name, through a temp file and rename. */
+int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
+
+/* Verifies a directory: DIR/MANIFEST exists and parses, every listed file is
+ * present with a matching SHA-256, and no .vec file in DIR is unlisted.
+ * On success m holds the manifest (caller frees).  0 or -1 with err set. */
+int cbvh_manifest_verify_dir(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
+
+void cbvh_manifest_free(cbvh_manifest *m);
+
+/* Is name acceptable as a manifest entry (plain file name, printable, no '/')? */
+int cbvh_manifest_name_ok(const char *name, size_t n);
+
+#endif

@@ -1,0 +1,1009 @@
+/* Golden vector generator: TestFloat-style structured corner cases (level 1)
+ * plus random cases (level 2).  Integer-only: inputs are built as binary32
+ * bit patterns, so the files are identical on every host. */
+#include "vecgen.h"
+
+#include "cbvh/traversal_units.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- PRNG: splitmix64 seeds xoshiro256** --------------------------------- */
+
+typedef struct {
+    uint64_t s[4];
+} rng_t;
+
+static uint64_t splitmix64(uint64_t *x) {
+    uint64_t z = (*x += UINT64_C(0x9E3779B97F4A7C15));
+    z = (z ^ (z >> 30)) * UINT64_C(0xBF58476D1CE4E5B9);
+    z = (z ^ (z >> 27)) * UINT64_C(0x94D049BB133111EB);
+    return z ^ (z >> 31);
+}
+
+static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+
+static uint64_t rng_next(rng_t *r) {
+    uint64_t *s = r->s;
+    uint64_t result = rotl(s[1] * 5, 7) * 9, t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl(s[3], 45);
+    return result;
+}
+
+static void rng_seed(rng_t *r, uint64_t seed) {
+    for (int i = 0; i < 4; i++) r->s[i] = splitmix64(&seed);
+}
+
+/* Uniform in [0, n) (n > 0); the tiny modulo bias does not matter here. */
+static uint64_t rnd_below(rng_t *r, uint64_t n) { return rng_next(r) % n; }
+static int64_t rnd_range(rng_t *r, int64_t lo, int64_t hi) { return lo + (int64_t)rnd_below(r, (uint64_t)(hi - lo) + 1); }
+
+/* ---- binary32 patterns --------------------------------------------------- */
+
+static cbvh_f32 mkf(int sign, int e, uint32_t frac) {
+    return (sign ? CBVH_F32_SIGN : 0u) | (uint32_t)(e + 127) << 23 | (frac & CBVH_F32_FRAC);
+}
+static cbvh_f32 neg(cbvh_f32 x) { return x ^ CBVH_F32_SIGN; }
+
+/* Order-preserving integer key of a finite float (+0 and -0 both 0). */
+static int64_t fkey(cbvh_f32 x) { return (x & CBVH_F32_SIGN) ? -(int64_t)(x & ~CBVH_F32_SIGN) : (int64_t)x; }
+static cbvh_f32 funkey(int64_t k) { return k < 0 ? CBVH_F32_SIGN | (uint32_t)-k : (uint32_t)k; }
+static const int64_t KEY_MAX = CBVH_F32_MAX;
+
+static cbvh_f32 up(cbvh_f32 x) { return x == CBVH_F32_MAX ? x : cbvh_f32_next_up(x); }
+static cbvh_f32 down(cbvh_f32 x) { return x == (CBVH_F32_MAX | CBVH_F32_SIGN) ? x : cbvh_f32_next_down(x); }
+
+/* Exponents x significands, TestFloat style; subnormals separately. */
+static const int pat_exp[] = {-126, -125, -64, -32, -31, -30, -29, -25, -24, -23, -2, -1,
+                              0,    1,    2,   23,  24,  25,  40,  64,  100, 125, 126, 127};
+static const uint32_t pat_frac[] = {0, 1, 0x400000, 0x7FFFFE, 0x7FFFFF};
+static const uint32_t pat_sub[] = {1, 2, 0x400000, 0x7FFFFF};
+#define N_EXP (int)(sizeof pat_exp / sizeof pat_exp[0])
+#define N_FRAC (int)(sizeof pat_frac / sizeof pat_frac[0])
+#define N_SUB (int)(sizeof pat_sub / sizeof pat_sub[0])
+#define N_MAG (1 + N_SUB + N_EXP * N_FRAC)
+
+/* Magnitude pattern i in [0, N_MAG): zero, subnormals, then exponent x fraction. */
+static cbvh_f32 pat_mag(int i) {
+    if (i == 0) return 0;
+    if (i <= N_SUB) return pat_sub[i - 1];
+    i -= 1 + N_SUB;
+    return mkf(0, pat_exp[i / N_FRAC], pat_frac[i % N_FRAC]);
+}
+
+#define F_NEG_0_4 0xBECCCCCDu /* -0.4f: the cloth plane */
+#define F_ONE 0x3F800000u
+#define F_TWO40 0x53800000u /* 2^40 */
+#define F_TWO24 0x4B800000u /* 2^24 */
+/* A handful of values whose pairs make boxes (incl. straddling zero). */
+static const cbvh_f32 box_vals[] = {
+    0x00000000, 0x80000000, 0x00000001, 0x80000001, 0x00800000, 0x30800000 /* 2^-30 */, 0x33C00000 /* 1.5*2^-24 */,
+    0x3DCCCCCD /* 0.1 */, F_NEG_0_4, F_ONE, 0x3F800001, 0xBF800000, 0x40400000 /* 3 */, 0xC0B00000 /* -5.5 */,
+    F_TWO24, 0x4B800001 /* 2^24+2 */, 0x49742400 /* 1e6 */, F_TWO40, 0xD3800000 /* -2^40 */, CBVH_F32_MAX,
+    CBVH_F32_MAX | CBVH_F32_SIGN, 0x7F000000 /* 2^127 */};
+#define N_BOX_VALS (int)(sizeof box_vals / sizeof box_vals[0])
+
+static const cbvh_f32 nan_inf[] = {0x7FC00000, 0x7F800001, 0xFFC00000, 0x7FFFFFFF, CBVH_F32_POS_INF, CBVH_F32_NEG_INF};
+#define N_NAN_INF (int)(sizeof nan_inf / sizeof nan_inf[0])
+
+/* Random float with TestFloat-like structure: random sign, an exponent that
+ * is often near the interesting ones, and a significand with runs of ones. */
+static cbvh_f32 rnd_float(rng_t *r) {
+    uint64_t k = rnd_below(r, 8);
+    int sign = (int)rnd_below(r, 2);
+    if (k == 0) { /* any finite bit pattern */
+        cbvh_f32 x;
+        do x = (cbvh_f32)rng_next(r);
+        while (cbvh_f32_is_nan_or_inf(x));
+        return x;
+    }
+    if (k == 1) return pat_mag((int)rnd_below(r, N_MAG)) | (sign ? CBVH_F32_SIGN : 0u);
+    int e = k <= 4 ? (int)rnd_range(r, -40, 40) : (int)rnd_range(r, -126, 127);
+    uint32_t frac;
+    switch (rnd_below(r, 4)) {
+    case 0: frac = (uint32_t)rng_next(r); break;
+    case 1: frac = (uint32_t)(((uint64_t)1 << rnd_below(r, 24)) - 1); break;                  /* low ones */
+    case 2: frac = ~(uint32_t)(((uint64_t)1 << rnd_below(r, 24)) - 1); break;                 /* high ones */
+    default: {
+        uint32_t bits = (uint32_t)rng_next(r); /* one call per statement: C leaves argument order open */
+        frac = bits & ~(uint32_t)(((uint64_t)1 << rnd_below(r, 24)) - 1);
+        break;
+    }
+    }
+    return mkf(sign, e, frac);
+}
+
+/* Random finite float in [a, b] (a <= b): near either end or anywhere. */
+static cbvh_f32 rnd_between(rng_t *r, cbvh_f32 a, cbvh_f32 b) {
+    int64_t ka = fkey(a), kb = fkey(b);
+    switch (rnd_below(r, 4)) {
+    case 0: return funkey(ka + (int64_t)rnd_below(r, (uint64_t)(kb - ka < 16 ? kb - ka + 1 : 16)));
+    case 1: return funkey(kb - (int64_t)rnd_below(r, (uint64_t)(kb - ka < 16 ? kb - ka + 1 : 16)));
+    default: return funkey(rnd_range(r, ka, kb));
+    }
+}
+
+typedef struct {
+    cbvh_f32 lo, hi;
+} box_t;
+
+/* A random box: a random float plus a random extent in ulps (often tiny). */
+static box_t rnd_box(rng_t *r) {
+    box_t b;
+    uint64_t kind = rnd_below(r, 4);
+    if (kind == 0) {
+        b.lo = rnd_float(r);
+        b.hi = rnd_float(r);
+        if (cbvh_f32_cmp(b.lo, b.hi) > 0) {
+            cbvh_f32 t = b.lo;
+            b.lo = b.hi;
+            b.hi = t;
+        }
+        return b;
+    }
+    b.lo = rnd_float(r);
+    int64_t k = fkey(b.lo), ext = (int64_t)rnd_below(r, (uint64_t)1 << rnd_below(r, 32));
+    if (ext > KEY_MAX - k) ext = KEY_MAX - k;
+    b.hi = funkey(k + ext);
+    return b;
+}
+
+/* A random sub-box of [lo, hi] (finite, lo <= hi). */
+static box_t rnd_sub_box(rng_t *r, box_t in) {
+    box_t b;
+    switch (rnd_below(r, 8)) {
+    case 0: return in;
+    case 1: b.lo = b.hi = in.lo; return b;
+    case 2: b.lo = b.hi = in.hi; return b;
+    default: break;
+    }
+    b.lo = rnd_between(r, in.lo, in.hi);
+    b.hi = rnd_between(r, in.lo, in.hi);
+    if (cbvh_f32_cmp(b.lo, b.hi) > 0) {
+        cbvh_f32 t = b.lo;
+        b.lo = b.hi;
+        b.hi = t;
+    }
+    return b;
+}
+
+/* ---- the vector list ------------------------------------------------------ */
+
+typedef struct {
+    const cbvh_vecgen_spec *spec;
+    cbvh_layout lay;
+    rng_t rng;
+    uint32_t *in;
+    size_t n, cap;
+    int oom;
+    int random_only; /* level 2's extra part: random cases only */
+    int N;         /* quant_bits */
+    int ms;        /* min_scale */
+    uint32_t mask; /* 2^N - 1 */
+} gen_t;
+
+static void emit(gen_t *g, const uint32_t *in) {
+    if (g->oom) return;
+    if (g->n == g->cap) {
+        size_t cap = g->cap ? g->cap * 2 : 1024;
+        uint32_t *ni = realloc(g->in, cap * (size_t)g->lay.n_in * sizeof *ni);
+        if (!ni) {
+            g->oom = 1;
+            return;
+        }
+        g->in = ni;
+        g->cap = cap;
+    }
+    uint32_t *dst = g->in + g->n * (size_t)g->lay.n_in;
+    /* Keep every input inside its field so the file can be written. */
+    for (int i = 0; i < g->lay.n_in; i++) {
+        int d = g->lay.in[i].hex_digits;
+        dst[i] = d >= 8 ? in[i] : in[i] & ((1u << (4 * d)) - 1u);
+    }
+    g->n++;
+}
+
+static int valid_scale_word(int e) { return e >= -128 && e <= 127; }
+
+/* ---- scale_estimate -------------------------------------------------------- */
+
+static void emit_box2(gen_t *g, cbvh_f32 lo, cbvh_f32 hi) {
+    uint32_t in[2] = {lo, hi};
+    emit(g, in);
+}
+
+/* Structured boxes shared by the estimator and the compressor.  step thins
+ * the pattern loops (1 = all). */
+static size_t structured_boxes(box_t *out, size_t max, int step) {
+    size_t n = 0;
+#define PUT(a, b)                                                                                                     \
+    do {                                                                                                               \
+        if (n < max) out[n] = (box_t){(a), (b)};                                                                       \
+        n++;                                                                                                           \
+    } while (0)
+    for (int i = 0; i < N_MAG; i += step) {
+        cbvh_f32 m = pat_mag(i);
+        PUT(m, m);                   /* zero-width */
+        PUT(neg(m), neg(m));         /* zero-width, negative (incl. -0) */
+        PUT(m, up(m));               /* one ulp */
+        PUT(down(neg(m)), neg(m));   /* one ulp, negative */
+        if (i % (2 * step) == 0) PUT(neg(m), m); /* straddling zero */
+    }
+    for (int i = 0; i < N_BOX_VALS; i++)
+        for (int j = 0; j < N_BOX_VALS; j += step)
+            if (cbvh_f32_cmp(box_vals[i], box_vals[j]) < 0) PUT(box_vals[i], box_vals[j]);
+    /* Far from the origin with tiny extents, and the cloth plane. */
+    PUT(F_TWO40, up(F_TWO40));
+    PUT(neg(up(F_TWO40)), neg(F_TWO40));
+    PUT(F_TWO24, up(up(F_TWO24)));
+    PUT(mkf(0, 100, 0x123456), up(mkf(0, 100, 0x123456)));
+    PUT(F_NEG_0_4, F_NEG_0_4);
+    PUT(down(F_NEG_0_4), up(F_NEG_0_4));
+    PUT(0xBED1EB85 /* -0.41 */, 0xBEC7AE14 /* -0.39 */);
+    PUT(0x80000000, 0x00000000);
+    PUT(0x00000000, 0x80000000);
+#undef PUT
+    return n;
+}
+
+static void rejects(gen_t *g, void (*put)(gen_t *, cbvh_f32, cbvh_f32, int), int scale) {
+    for (int i = 0; i < N_NAN_INF; i++) {
+        put(g, nan_inf[i], F_ONE, scale);
+        put(g, 0xBF800000, nan_inf[i], scale);
+        put(g, nan_inf[i], nan_inf[i], scale);
+    }
+    put(g, CBVH_F32_NEG_INF, CBVH_F32_POS_INF, scale);
+    put(g, F_ONE, 0, scale);                         /* inverted */
+    put(g, up(F_ONE), F_ONE, scale);                 /* inverted by one ulp */
+    put(g, 0x00000000, 0x80000001, scale);           /* inverted across zero */
+    put(g, CBVH_F32_MAX, CBVH_F32_MAX | CBVH_F32_SIGN, scale);
+}
+
+static void put_estimate(gen_t *g, cbvh_f32 lo, cbvh_f32 hi, int scale) {
+    (void)scale;
+    emit_box2(g, lo, hi);
+}
+
+static void gen_estimate(gen_t *g, size_t target) {
+    if (!g->random_only) { /* level-1 structured cases */
+        box_t boxes[2048];
+        size_t nb = structured_boxes(boxes, 2048, 1);
+        for (size_t i = 0; i < nb && i < 2048; i++) emit_box2(g, boxes[i].lo, boxes[i].hi);
+        rejects(g, put_estimate, 0);
+    }
+    while (g->n < target && !g->oom) {
+        box_t b = rnd_box(&g->rng);
+        emit_box2(g, b.lo, b.hi);
+    }
+}
+
+/* ---- axis_compress --------------------------------------------------------- */
+
+static void emit_compress(gen_t *g, cbvh_f32 lo, cbvh_f32 hi, int e) {
+    if (!valid_scale_word(e)) return;
+    uint32_t in[3] = {lo, hi, cbvh_scale_to_word(e)};
+    emit(g, in);
+}
+
+static void put_compress(gen_t *g, cbvh_f32 lo, cbvh_f32 hi, int scale) { emit_compress(g, lo, hi, scale); }
+
+/* Scales around the estimate: estimate-1 (forces NO_FIT), the estimate,
+ * +1..+3, the minimum and the maximum scale. */
+static void compress_scales(gen_t *g, cbvh_f32 lo, cbvh_f32 hi, int all) {
+    cbvh_params p = g->spec->cfg.params;
+    int est;
+    if (cbvh_scale_estimate(&p, lo, hi, &est) != 0) est = 0;
+    emit_compress(g, lo, hi, est);
+    if (est - 1 >= g->ms) emit_compress(g, lo, hi, est - 1);
+    emit_compress(g, lo, hi, est + 1);
+    if (all) {
+        emit_compress(g, lo, hi, est + 2);
+        emit_compress(g, lo, hi, est + 3);
+    }
+    if (est != g->ms) emit_compress(g, lo, hi, g->ms);
+    if (all && est != CBVH_SCALE_CEIL) emit_compress(g, lo, hi, CBVH_SCALE_CEIL);
+}
+
+static void gen_compress(gen_t *g, size_t target) {
+    if (!g->random_only) { /* level-1 structured cases */
+        box_t boxes[2048];
+        size_t nb = structured_boxes(boxes, 2048, 2);
+        for (size_t i = 0; i < nb && i < 2048; i++) compress_scales(g, boxes[i].lo, boxes[i].hi, i % 3 == 0);
+        rejects(g, put_compress, 0);
+        /* Bad scales: below min_scale, above 126, the 8-bit extremes. */
+        static const cbvh_f32 some[][2] = {{F_ONE, 0x40400000}, {0, 0}, {F_NEG_0_4, F_NEG_0_4}, {CBVH_F32_MAX, CBVH_F32_MAX}};
+        for (int i = 0; i < 4; i++) {
+            emit_compress(g, some[i][0], some[i][1], g->ms - 1);
+            emit_compress(g, some[i][0], some[i][1], 127);
+            emit_compress(g, some[i][0], some[i][1], -128);
+        }
+    }
+    while (g->n < target && !g->oom) {
+        box_t b = rnd_box(&g->rng);
+        int est;
+        cbvh_params p = g->spec->cfg.params;
+        if (cbvh_scale_estimate(&p, b.lo, b.hi, &est) != 0) est = 0;
+        int e;
+        switch (rnd_below(&g->rng, 4)) {
+        case 0: e = (int)rnd_range(&g->rng, g->ms, CBVH_SCALE_CEIL); break;
+        case 1: e = est; break;
+        default: e = est + (int)rnd_range(&g->rng, -2, 4); break;
+        }
+        if (e < g->ms - 1) e = g->ms - 1;
+        emit_compress(g, b.lo, b.hi, e);
+    }
+}
+
+/* ---- axis_decode ----------------------------------------------------------- */
+
+static void emit_decode(gen_t *g, const cbvh_axis_ctx *c, uint32_t lb_code, uint32_t ub_code) {
+    if (!valid_scale_word(c->parent_scale) || !valid_scale_word(c->scale)) return;
+    uint32_t in[6] = {cbvh_scale_to_word(c->parent_scale), cbvh_scale_to_word(c->scale), c->lb_mod, c->clb, lb_code,
+                      ub_code};
+    emit(g, in);
+}
+
+/* Root boxes for the decoder and node-pair chains. */
+static const box_t root_boxes[] = {
+    {0xBF800000, F_ONE},                     /* [-1, 1] */
+    {0x00000000, F_ONE},                     /* [0, 1] */
+    {F_NEG_0_4, F_NEG_0_4},                  /* cloth plane, zero width */
+    {0xBF000000, F_NEG_0_4},                 /* [-0.5, -0.4] */
+    {F_TWO40, 0x53800001},                   /* [2^40, nextup(2^40)] */
+    {0xD3800001, 0xD3800000},                /* its mirror */
+    {CBVH_F32_MAX | CBVH_F32_SIGN, CBVH_F32_MAX}, /* the whole float line: clb = -Inf */
+    {0x7E000000, CBVH_F32_MAX},              /* near FLT_MAX: cub overflows */
+    {0x00000001, 0x00000010},                /* subnormals */
+    {0x80000000, 0x00000000},                /* -0 .. 0 */
+    {0x30800000, 0x30800000},                /* 2^-30 point */
+    {0xC0B00000, 0x4B800001},                /* [-5.5, 2^24+2] */
+    {0x3DCCCCCD, 0x49742400},                /* [0.1, 1e6] */
+    {0x4B7FFFFF, 0x4B800001},                /* around 2^24 */
+};
+#define N_ROOT (int)(sizeof root_boxes / sizeof root_boxes[0])
+
+static box_t pick_root(gen_t *g, int i) {
+    if (i < N_ROOT) return root_boxes[i];
+    return rnd_box(&g->rng);
+}
+
+/* One chain: a root box, a child inside it and a grandchild inside the
+ * child; emits the decode vectors of both levels (the stored codes of a real
+ * compression) plus random codes under the same contexts. */
+static void decode_chain(gen_t *g, box_t root, int extras) {
+    const cbvh_params *p = &g->spec->cfg.params;
+    cbvh_encoding enc = g->spec->cfg.enc;
+    cbvh_axis_ctx ctx;
+    if (cbvh_axis_root_ctx(p, root.lo, root.hi, &ctx) != 0) return;
+    box_t node = root;
+    for (int depth = 0; depth < 2; depth++) {
+        box_t child = rnd_sub_box(&g->rng, node);
+        cbvh_axis_code code;
+        if (cbvh_axis_compress(p, child.lo, child.hi, ctx.scale, &code) & CBVH_ST_REJECT) return;
+        uint32_t lc, uc;
+        cbvh_axis_store_codes(p, enc, &ctx, &code, &lc, &uc);
+        emit_decode(g, &ctx, lc, uc);
+        if (extras) {
+            uint32_t a = (uint32_t)rnd_below(&g->rng, g->mask + 1u), b = (uint32_t)rnd_below(&g->rng, g->mask + 1u);
+            emit_decode(g, &ctx, a, b);
+        }
+        ctx = cbvh_axis_child_ctx(&ctx, &code);
+        node = child;
+    }
+}
+
+static void gen_decode(gen_t *g, size_t target) {
+    const cbvh_params *p = &g->spec->cfg.params;
+    uint32_t full = g->mask + 1u;
+    if (!g->random_only) { /* level-1 structured cases */
+        /* Real chains from structured roots, several children each. */
+        for (int i = 0; i < N_ROOT; i++)
+            for (int k = 0; k < 12; k++) decode_chain(g, root_boxes[i], 1);
+        /* Corner codes under real contexts. */
+        for (int i = 0; i < N_ROOT; i++) {
+            cbvh_axis_ctx ctx;
+            if (cbvh_axis_root_ctx(p, root_boxes[i].lo, root_boxes[i].hi, &ctx) != 0) continue;
+            int shift = ctx.parent_scale - ctx.scale;
+            uint32_t pmod = shift >= g->N ? 0 : (ctx.lb_mod << shift) & g->mask;
+            emit_decode(g, &ctx, pmod, pmod);                       /* r = 0, s = 0 -> 2^N: the whole node */
+            emit_decode(g, &ctx, pmod, (pmod + 1) & g->mask);       /* first cell */
+            emit_decode(g, &ctx, (pmod + g->mask) & g->mask, pmod); /* last cell */
+            emit_decode(g, &ctx, 0, 0);
+            emit_decode(g, &ctx, g->mask, g->mask);                  /* r == s: inverted (unless s == 0) */
+            emit_decode(g, &ctx, 1, 0);
+            emit_decode(g, &ctx, full, 0);                           /* codes >= 2^N */
+            emit_decode(g, &ctx, 0, full);
+            emit_decode(g, &ctx, 0xFFF, 0xFFF);
+            /* Bad contexts. */
+            cbvh_axis_ctx b = ctx;
+            b.lb_mod = full;
+            emit_decode(g, &b, 0, 1);
+            b = ctx;
+            b.clb = 0x7FC00000;
+            emit_decode(g, &b, 0, 1);
+            b.clb = CBVH_F32_POS_INF;
+            emit_decode(g, &b, 0, 1);
+            b.clb = CBVH_F32_NEG_INF; /* valid: -2^128 */
+            emit_decode(g, &b, 0, 1);
+            emit_decode(g, &b, 0, 0);
+            b = ctx;
+            b.scale = g->ms - 1;
+            emit_decode(g, &b, 0, 1);
+            b = ctx;
+            b.parent_scale = ctx.scale - 1;
+            emit_decode(g, &b, 0, 1);
+            b = ctx;
+            b.parent_scale = 127;
+            emit_decode(g, &b, 0, 1);
+            b = ctx;
+            b.parent_scale = CBVH_SCALE_CEIL;
+            emit_decode(g, &b, 1, 3); /* shift >= N: p^ = 0 */
+            b = ctx;
+            b.scale = b.parent_scale = g->ms;
+            emit_decode(g, &b, 2, 5); /* minimum-scale saturation */
+        }
+        /* Random contexts with every field in range. */
+        for (int i = 0; i < 40; i++) {
+            cbvh_axis_ctx c;
+            c.scale = (int)rnd_range(&g->rng, g->ms, CBVH_SCALE_CEIL);
+            c.parent_scale = (int)rnd_range(&g->rng, c.scale, CBVH_SCALE_CEIL);
+            c.lb_mod = (uint32_t)rnd_below(&g->rng, full);
+            c.clb = rnd_float(&g->rng);
+            uint32_t lc = (uint32_t)rnd_below(&g->rng, full);
+            uint32_t uc = (uint32_t)rnd_below(&g->rng, full);
+            emit_decode(g, &c, lc, uc);
+        }
+    }
+    /* Then chains from random roots, every fourth from a structured one. */
+    for (int i = 0; g->n < target && !g->oom; i++) decode_chain(g, pick_root(g, i % 4 == 0 ? (i / 4) % N_ROOT : N_ROOT), 1);
+}
+
+/* ---- node pairs -------------------------------------------------------------- */
+
+typedef struct {
+    box_t axis[3];
+    cbvh_node_ctx ctx;
+} node_t;
+
+static int make_node(gen_t *g, node_t *nd, int i) {
+    for (int a = 0; a < 3; a++) {
+        /* Mix structured roots per axis so a node sees different cases on x, y, z. */
+        nd->axis[a] = i < N_ROOT ? root_boxes[(i + 5 * a) % N_ROOT] : rnd_box(&g->rng);
+        if (cbvh_axis_root_ctx(&g->spec->cfg.params, nd->axis[a].lo, nd->axis[a].hi, &nd->ctx.axis[a]) != 0) return -1;
+    }
+    return 0;
+}
+
+static uint32_t ptr_ones(int n) {
+    int pb = cbvh_node_ptr_bits(n);
+    return pb >= 32 ? 0xFFFFFFFFu : (1u << pb) - 1u;
+}
+
+static void ctx_words(const cbvh_node_ctx *c, uint32_t *w) {
+    for (int a = 0; a < 3; a++) {
+        w[4 * a] = cbvh_scale_to_word(c->axis[a].parent_scale);
+        w[4 * a + 1] = cbvh_scale_to_word(c->axis[a].scale);
+        w[4 * a + 2] = c->axis[a].lb_mod;
+        w[4 * a + 3] = c->axis[a].clb;
+    }
+}
+
+typedef struct {
+    box_t b[3];
+    uint32_t flags, ptr;
+} child_t;
+
+static child_t rnd_child(gen_t *g, const node_t *nd) {
+    child_t c;
+    for (int a = 0; a < 3; a++) c.b[a] = rnd_sub_box(&g->rng, nd->axis[a]);
+    uint32_t ones = ptr_ones(g->N);
+    c.flags = (uint32_t)rnd_below(&g->rng, 2); /* leaf or inner */
+    switch (rnd_below(&g->rng, 4)) {
+    case 0: c.ptr = (uint32_t)rnd_below(&g->rng, 16); break;
+    case 1: c.ptr = ones - 1; break;
+    default: c.ptr = (uint32_t)rnd_below(&g->rng, (uint64_t)ones); break;
+    }
+    return c;
+}
+
+/* Sequenced on purpose: the order of initializers is unspecified in C. */
+static void two_children(gen_t *g, const node_t *nd, child_t ch[2]) {
+    ch[0] = rnd_child(g, nd);
+    ch[1] = rnd_child(g, nd);
+}
+
+static void encode_inputs(const node_t *nd, const child_t ch[2], uint32_t *in) {
+    ctx_words(&nd->ctx, in);
+    for (int c = 0; c < 2; c++) {
+        uint32_t *w = in + 12 + 8 * c;
+        for (int a = 0; a < 3; a++) {
+            w[2 * a] = ch[c].b[a].lo;
+            w[2 * a + 1] = ch[c].b[a].hi;
+        }
+        w[6] = ch[c].flags;
+        w[7] = ch[c].ptr;
+    }
+}
+
+/* The structured variations of one node's two children (encoder inputs). */
+static int pair_cases(gen_t *g, const node_t *nd, child_t out[][2], int max) {
+    int n = 0;
+    uint32_t ones = ptr_ones(g->N);
+    child_t a = rnd_child(g, nd), b = rnd_child(g, nd);
+#define CASE(x, y)                                                                                                    \
+    do {                                                                                                               \
+        if (n < max) {                                                                                                 \
+            out[n][0] = (x);                                                                                           \
+            out[n][1] = (y);                                                                                           \
+            n++;                                                                                                       \
+        }                                                                                                              \
+    } while (0)
+    CASE(a, b);
+    child_t t = a, u = b;
+    t.flags = 1; /* two leaves */
+    u.flags = 1;
+    CASE(t, u);
+    u.flags = 2; /* second empty, its box ignored */
+    CASE(t, u);
+    t.flags = 3; /* both empty (leaf bit with empty too) */
+    u.flags = 2;
+    CASE(t, u);
+    t = a;
+    t.flags = 0;
+    t.ptr = ones; /* inner child at the all-ones pointer */
+    u = b;
+    u.flags = 1;
+    u.ptr = ones - 1; /* largest leaf pointer */
+    CASE(t, u);
+    u.ptr = ones; /* leaf at the reserved pointer: bad format */
+    CASE(t, u);
+    if (ones != 0xFFFFFFFFu) {
+        t.ptr = ones + 1; /* pointer too wide */
+        CASE(t, b);
+    }
+    t = a;
+    t.flags = 0xC; /* unused flag bits */
+    CASE(t, b);
+    /* A child box wider than the node: NO_FIT on that axis. */
+    t = a;
+    t.b[rnd_below(&g->rng, 3)] = (box_t){CBVH_F32_MAX | CBVH_F32_SIGN, CBVH_F32_MAX};
+    CASE(t, b);
+    /* NaN / inverted child. */
+    t = a;
+    t.b[rnd_below(&g->rng, 3)].lo = 0x7FC00000;
+    CASE(b, t);
+    t = a;
+    t.b[1] = (box_t){t.b[1].hi, t.b[1].lo};
+    if (cbvh_f32_cmp(t.b[1].lo, t.b[1].hi) > 0) CASE(t, b);
+#undef CASE
+    return n;
+}
+
+static void emit_encode(gen_t *g, const node_t *nd, const child_t ch[2]) {
+    uint32_t in[28];
+    encode_inputs(nd, ch, in);
+    emit(g, in);
+}
+
+static void gen_encode_pair(gen_t *g, size_t target) {
+    if (!g->random_only) { /* level-1 structured cases */
+        for (int i = 0; i < N_ROOT * 2 && !g->oom; i++) {
+            node_t nd;
+            if (make_node(g, &nd, i % N_ROOT) != 0) continue;
+            child_t cases[16][2];
+            int nc = pair_cases(g, &nd, cases, 16);
+            for (int k = 0; k < nc; k++) emit_encode(g, &nd, cases[k]);
+        }
+        /* Bad contexts: a bad scale, an out-of-range lb_mod, a NaN clb on one axis. */
+        for (int i = 0; i < 6; i++) {
+            node_t nd;
+            if (make_node(g, &nd, i) != 0) continue;
+            child_t ch[2];
+            two_children(g, &nd, ch);
+            cbvh_axis_ctx *ax = &nd.ctx.axis[i % 3];
+            if (i < 3) ax->scale = g->ms - 1;
+            else if (i < 5) ax->lb_mod = g->mask + 1u;
+            else ax->clb = 0x7FC00000;
+            emit_encode(g, &nd, ch);
+        }
+    }
+    while (g->n < target && !g->oom) {
+        node_t nd;
+        if (make_node(g, &nd, N_ROOT) != 0) continue;
+        child_t ch[2];
+        two_children(g, &nd, ch);
+        if (rnd_below(&g->rng, 8) == 0) ch[rnd_below(&g->rng, 2)].flags = 2;
+        emit_encode(g, &nd, ch);
+    }
+}
+
+static void emit_decode_pair(gen_t *g, const cbvh_node_ctx *ctx, const uint32_t *words, int nw) {
+    uint32_t in[18];
+    ctx_words(ctx, in);
+    for (int i = 0; i < nw; i++) in[12 + i] = words[i];
+    emit(g, in);
+}
+
+/* Decoder inputs from real node pairs (encoded by the model's encoder unit),
+ * then corruptions of them: reserved bits, flipped code bits, garbage. */
+static void decode_pair_node(gen_t *g, const cbvh_unit *enc_unit, const node_t *nd, child_t cases[][2], int nc,
+                             int corrupt) {
+    int nw = (int)cbvh_nodepair_bytes(g->N) / 4;
+    int w = cbvh_node_bits(g->N), pb = cbvh_node_ptr_bits(g->N);
+    int reserved = w - 6 * g->N - 1 - pb; /* per node */
+    for (int k = 0; k < nc; k++) {
+        uint32_t in[28], out[8];
+        encode_inputs(nd, cases[k], in);
+        enc_unit->eval(&g->spec->cfg, in, out);
+        if (out[nw] & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT)) continue; /* zeroed words: nothing to decode */
+        emit_decode_pair(g, &nd->ctx, out, nw);
+        if (!corrupt || k > 1) continue;
+        uint32_t bad[6];
+        if (reserved > 0) {
+            memcpy(bad, out, sizeof bad);
+            int node = (int)rnd_below(&g->rng, 2);
+            int bit = node * w + 6 * g->N + 1 + pb + (int)rnd_below(&g->rng, (uint64_t)reserved);
+            bad[bit / 32] ^= 1u << (bit % 32);
+            emit_decode_pair(g, &nd->ctx, bad, nw);
+        }
+        memcpy(bad, out, sizeof bad);
+        int cb = (int)rnd_below(&g->rng, (uint64_t)g->N * 6); /* one code bit of node 0 flipped */
+        bad[cb / 32] ^= 1u << (cb % 32);
+        emit_decode_pair(g, &nd->ctx, bad, nw);
+        for (int j = 0; j < nw; j++) bad[j] = (uint32_t)rng_next(&g->rng); /* garbage words */
+        emit_decode_pair(g, &nd->ctx, bad, nw);
+    }
+}
+
+static void gen_decode_pair(gen_t *g, size_t target) {
+    const cbvh_unit *enc_unit = cbvh_unit_find("nodepair_encode");
+    int nw = (int)cbvh_nodepair_bytes(g->N) / 4;
+    if (!g->random_only) { /* level-1 structured cases */
+        for (int i = 0; i < N_ROOT * 2 && !g->oom; i++) {
+            node_t nd;
+            if (make_node(g, &nd, i % N_ROOT) != 0) continue;
+            child_t cases[16][2];
+            int nc = pair_cases(g, &nd, cases, 16);
+            decode_pair_node(g, enc_unit, &nd, cases, nc, 1);
+            if (i >= N_ROOT) continue;
+            /* Malformed empty marker: leaf + all-ones pointer but a nonzero code. */
+            child_t ch[2];
+            two_children(g, &nd, ch);
+            ch[0].flags = 2;
+            uint32_t in[28], out[8];
+            encode_inputs(&nd, ch, in);
+            enc_unit->eval(&g->spec->cfg, in, out);
+            out[0] |= 1u;
+            emit_decode_pair(g, &nd.ctx, out, nw);
+            static const uint32_t zero[6], ones[6] = {~0u, ~0u, ~0u, ~0u, ~0u, ~0u};
+            emit_decode_pair(g, &nd.ctx, zero, nw);
+            emit_decode_pair(g, &nd.ctx, ones, nw);
+            cbvh_node_ctx bc = nd.ctx;
+            bc.axis[i % 3].parent_scale = bc.axis[i % 3].scale - 1; /* bad context */
+            emit_decode_pair(g, &bc, out, nw);
+        }
+    }
+    while (g->n < target && !g->oom) {
+        node_t nd;
+        if (make_node(g, &nd, N_ROOT) != 0) continue;
+        if (rnd_below(&g->rng, 16) == 0) { /* garbage words under a real context */
+            uint32_t junk[6];
+            for (int j = 0; j < nw; j++) junk[j] = (uint32_t)rng_next(&g->rng);
+            emit_decode_pair(g, &nd.ctx, junk, nw);
+            continue;
+        }
+        child_t ch[1][2];
+        two_children(g, &nd, ch[0]);
+        decode_pair_node(g, enc_unit, &nd, ch, 1, 0);
+    }
+}
+
+/* ---- ray_box (docs/traversal.md §3) ------------------------------------------ */
+
+/* Input words: o[3] d[3] tmin tmax mant, then per axis u scale r s. */
+static void emit_ray_box(gen_t *g, const cbvh_f32 o[3], const cbvh_f32 d[3], cbvh_f32 tmin, cbvh_f32 tmax, int mant,
+                         const cbvh_f32 u[3], const int e[3], const uint32_t r[3], const uint32_t s[3]) {
+    uint32_t in[21];
+    for (int a = 0; a < 3; a++) {
+        in[a] = o[a];
+        in[3 + a] = d[a];
+        in[9 + 4 * a] = u[a];
+        in[10 + 4 * a] = cbvh_scale_to_word(e[a]);
+        in[11 + 4 * a] = r[a];
+        in[12 + 4 * a] = s[a];
+    }
+    in[6] = tmin;
+    in[7] = tmax;
+    in[8] = (uint32_t)mant;
+    emit(g, in);
+}
+
+#define F_HALF 0x3F000000u
+#define F_THIRD 0x3EAAAAABu
+static const cbvh_f32 rb_orig[] = {0xBF800000u /* -1 */, 0, CBVH_F32_SIGN, F_HALF, F_ONE /* on the face x=1 */,
+                                   0x3F800001u /* just outside */, 0x40000000u /* 2 */, 0x33800000u /* 2^-24 */};
+static const cbvh_f32 rb_dir[] = {F_ONE, 0xBF800000u, 0, CBVH_F32_SIGN, F_THIRD, 0x00000001u /* tiny */,
+                                  0x7F000000u /* 2^127 */, 0xC0400000u /* -3 */};
+static const int rb_mant[] = {3, 8, 12, 24};
+#define N_RB_ORIG (int)(sizeof rb_orig / sizeof rb_orig[0])
+#define N_RB_DIR (int)(sizeof rb_dir / sizeof rb_dir[0])
+
+static void gen_ray_box(gen_t *g, size_t target) {
+    if (!g->random_only) {
+        /* the box [0,1]^3 as u = 0, e = -3, r = 0, s = 8; axis x structured, y/z through the middle */
+        const cbvh_f32 u[3] = {0, 0, 0};
+        const int e[3] = {-3, -3, -3};
+        const uint32_t r[3] = {0, 0, 0}, sc[3] = {8, 8, 8};
+        for (int m = 0; m < 4; m++)
+            for (int i = 0; i < N_RB_ORIG; i++)
+                for (int j = 0; j < N_RB_DIR; j++) {
+                    cbvh_f32 o[3] = {rb_orig[i], F_HALF, F_HALF}, d[3] = {rb_dir[j], rb_dir[(j + 1) % N_RB_DIR],
+                                                                          rb_dir[(j + 3) % N_RB_DIR]};
+                    if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1]) && cbvh_f32_is_zero(d[2])) d[2] = F_ONE;
+                    emit_ray_box(g, o, d, 0, CBVH_F32_POS_INF, rb_mant[m], u, e, r, sc);
+                    o[1] = F_ONE; /* on the face y = 1 (grazing when d_y = +-0) */
+                    emit_ray_box(g, o, d, 0, F_TWO24, rb_mant[m], u, e, r, sc);
+                }
+        /* extreme grids: -2^128 lower bound, scale 126, s = 2^10; tiny scale -126 */
+        const cbvh_f32 ue[3] = {CBVH_F32_NEG_INF, CBVH_F32_NEG_INF, 0x00000001u};
+        const int ee[3] = {126, 105, -126};
+        const uint32_t re[3] = {0, 1000, 3}, se[3] = {1024, 1024, 4};
+        for (int j = 0; j < N_RB_DIR; j++) {
+            cbvh_f32 o[3] = {CBVH_F32_MAX | CBVH_F32_SIGN, 0, 0x00000004u};
+            cbvh_f32 d[3] = {rb_dir[j], rb_dir[(j + 2) % N_RB_DIR], 0};
+            if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1])) d[0] = F_ONE;
+            for (int m = 0; m < 4; m++) emit_ray_box(g, o, d, 0, CBVH_F32_POS_INF, rb_mant[m], ue, ee, re, se);
+        }
+        /* rejects: NaN/Inf in every ray port, zero direction, bad M, scale, codes, inverted, u = +Inf */
+        for (int k = 0; k < N_NAN_INF; k++)
+            for (int port = 0; port < 8; port++) {
+                cbvh_f32 o[3] = {rb_orig[0], F_HALF, F_HALF}, d[3] = {F_ONE, 0, 0}, tmin = 0,
+                         tmax = CBVH_F32_POS_INF;
+                cbvh_f32 *w = port < 3 ? &o[port] : port < 6 ? &d[port - 3] : port == 6 ? &tmin : &tmax;
+                *w = nan_inf[k];
+                emit_ray_box(g, o, d, tmin, tmax, 24, u, e, r, sc);
+            }
+        {
+            const cbvh_f32 o[3] = {rb_orig[0], F_HALF, F_HALF}, dz[3] = {0, CBVH_F32_SIGN, 0}, d[3] = {F_ONE, 0, 0};
+            emit_ray_box(g, o, dz, 0, CBVH_F32_POS_INF, 24, u, e, r, sc);
+            static const int bad_m[] = {0, 2, 25, 255};
+            for (int k = 0; k < 4; k++) emit_ray_box(g, o, d, 0, CBVH_F32_POS_INF, bad_m[k], u, e, r, sc);
+            const int be[3] = {-127, 127, -128};
+            emit_ray_box(g, o, d, 0, CBVH_F32_POS_INF, 24, u, be, r, sc);
+            const uint32_t br[3] = {1025, 5, 0}, bs[3] = {1025, 5, 0};
+            emit_ray_box(g, o, d, 0, CBVH_F32_POS_INF, 24, u, e, br, bs);
+            const cbvh_f32 bu[3] = {CBVH_F32_POS_INF, 0x7FC00000u, 0};
+            emit_ray_box(g, o, d, 0, CBVH_F32_POS_INF, 24, bu, e, r, sc);
+        }
+    }
+    while (g->n < target && !g->oom) {
+        cbvh_f32 o[3], d[3], u[3];
+        int e[3];
+        uint32_t r[3], s[3];
+        for (int a = 0; a < 3; a++) {
+            u[a] = rnd_float(&g->rng);
+            uint64_t wide = rnd_below(&g->rng, 8);
+            e[a] = wide == 0 ? (int)rnd_range(&g->rng, -126, 126) : (int)rnd_range(&g->rng, -30, 10);
+            int bits = (int)rnd_range(&g->rng, 3, 10);
+            r[a] = (uint32_t)rnd_below(&g->rng, (uint64_t)1 << bits);
+            s[a] = r[a] + 1 + (uint32_t)rnd_below(&g->rng, ((uint64_t)1 << bits) - r[a]);
+            o[a] = rnd_float(&g->rng);
+            uint64_t kind = rnd_below(&g->rng, 6);
+            if (kind == 0) d[a] = rnd_below(&g->rng, 2) ? 0 : CBVH_F32_SIGN;
+            else if (kind == 1) { /* aim at the box's lower plane (when representable) */
+                d[a] = cbvh_f32_add_dyadic((int64_t)r[a], e[a], 0, 0, CBVH_RND_DOWN);
+            } else d[a] = rnd_float(&g->rng);
+        }
+        if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1]) && cbvh_f32_is_zero(d[2])) d[0] = F_ONE;
+        uint64_t tk = rnd_below(&g->rng, 3);
+        cbvh_f32 tmin = tk == 0 ? rnd_float(&g->rng) : 0;
+        cbvh_f32 tmax = tk == 2 ? rnd_float(&g->rng) : CBVH_F32_POS_INF;
+        int mant = (int)rnd_range(&g->rng, CBVH_MANT_MIN, CBVH_MANT_MAX);
+        emit_ray_box(g, o, d, tmin, tmax, mant, u, e, r, s);
+    }
+}
+
+/* ---- ray_triangle (docs/traversal.md §4) ----------------------------------------- */
+
+static void emit_ray_tri(gen_t *g, const cbvh_f32 o[3], const cbvh_f32 d[3], const cbvh_f32 v[9]) {
+    uint32_t in[15];
+    for (int a = 0; a < 3; a++) {
+        in[a] = o[a];
+        in[3 + a] = d[a];
+    }
+    for (int i = 0; i < 9; i++) in[6 + i] = v[i];
+    emit(g, in);
+}
+
+static void gen_ray_triangle(gen_t *g, size_t target) {
+    if (!g->random_only) {
+        /* unit right triangle in z = 0; rays down -z through vertices, edges, inside, just outside */
+        const cbvh_f32 tri[9] = {0, 0, 0, F_ONE, 0, 0, 0, F_ONE, 0};
+        static const cbvh_f32 xy[] = {0, CBVH_F32_SIGN, F_HALF, F_ONE, 0x3F000001u, 0x3E800000u /* .25 */,
+                                      0x3F7FFFFFu, 0xBF800000u};
+        const int nxy = (int)(sizeof xy / sizeof xy[0]);
+        static const cbvh_f32 dz[] = {0xBF800000u, F_ONE, CBVH_F32_SIGN | 0x00000001u, 0xC0400000u};
+        for (int i = 0; i < nxy; i++)
+            for (int j = 0; j < nxy; j++)
+                for (int k = 0; k < 4; k++) {
+                    const cbvh_f32 o[3] = {xy[i], xy[j], 0x40000000u}, d[3] = {0, CBVH_F32_SIGN, dz[k]};
+                    emit_ray_tri(g, o, d, tri);
+                    const cbvh_f32 d2[3] = {F_THIRD, 0xBE800000u, dz[k]};
+                    emit_ray_tri(g, o, d2, tri);
+                }
+        /* grazing: rays in the plane z = 0 and one subnormal above it */
+        for (int i = 0; i < nxy; i++) {
+            const cbvh_f32 o[3] = {0xBF800000u, xy[i], 0}, d[3] = {F_ONE, 0, 0};
+            emit_ray_tri(g, o, d, tri);
+            const cbvh_f32 o2[3] = {0xBF800000u, xy[i], 1}, d2[3] = {F_ONE, F_THIRD, CBVH_F32_SIGN};
+            emit_ray_tri(g, o2, d2, tri);
+        }
+        /* far from the origin */
+        const cbvh_f32 far[9] = {0x497423F0u, 0xC9F42408u, 0, 0x49742420u, 0xC9F42408u, 0, 0x49742400u, 0xC9F423F0u, 0};
+        const cbvh_f32 fo[3] = {0x49742400u, 0xC9F42400u, 0x49800000u}, fd[3] = {0, 0, 0xBF800000u};
+        emit_ray_tri(g, fo, fd, far);
+        /* rejects: NaN/Inf in each port, zero direction */
+        for (int k = 0; k < N_NAN_INF; k++)
+            for (int port = 0; port < 15; port++) {
+                cbvh_f32 o[3] = {0x3E800000u, 0x3E800000u, 0x40000000u}, d[3] = {0, 0, 0xBF800000u}, v[9];
+                memcpy(v, tri, sizeof v);
+                cbvh_f32 *w = port < 3 ? &o[port] : port < 6 ? &d[port - 3] : &v[port - 6];
+                *w = nan_inf[k];
+                emit_ray_tri(g, o, d, v);
+            }
+        const cbvh_f32 o[3] = {0x3E800000u, 0x3E800000u, 0x40000000u}, d0[3] = {CBVH_F32_SIGN, 0, CBVH_F32_SIGN};
+        emit_ray_tri(g, o, d0, tri);
+    }
+    while (g->n < target && !g->oom) {
+        cbvh_f32 o[3], d[3], v[9];
+        for (int i = 0; i < 9; i++) v[i] = rnd_float(&g->rng);
+        uint64_t kind = rnd_below(&g->rng, 3);
+        for (int a = 0; a < 3; a++) {
+            o[a] = rnd_float(&g->rng);
+            if (kind == 0) { /* aim at a vertex: d = v - o rounded down */
+                int s1, e1, s2, e2;
+                uint32_t m1, m2;
+                cbvh_f32_break(v[a], &s1, &m1, &e1);
+                cbvh_f32_break(o[a], &s2, &m2, &e2);
+                d[a] = cbvh_f32_add_dyadic(s1 ? -(int64_t)m1 : (int64_t)m1, e1, s2 ? (int64_t)m2 : -(int64_t)m2, e2,
+                                           CBVH_RND_DOWN);
+                if (cbvh_f32_is_nan_or_inf(d[a])) d[a] = F_ONE;
+            } else if (kind == 1 && rnd_below(&g->rng, 3) == 0) {
+                d[a] = rnd_below(&g->rng, 2) ? 0 : CBVH_F32_SIGN;
+            } else {
+                d[a] = rnd_float(&g->rng);
+            }
+        }
+        if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1]) && cbvh_f32_is_zero(d[2])) d[2] = F_ONE;
+        emit_ray_tri(g, o, d, v);
+    }
+}
+
+/* ---- files ------------------------------------------------------------------- */
+
+/* Vectors of a level-1 file per unit (the committed set stays small). */
+static size_t level1_target(const cbvh_unit *u) {
+    if (strcmp(u->name, "scale_estimate") == 0) return 2000;
+    if (strcmp(u->name, "axis_compress") == 0) return 2000;
+    if (strcmp(u->name, "axis_decode") == 0) return 1500;
+    if (strcmp(u->name, "ray_box") == 0) return 1500;
+    if (strcmp(u->name, "ray_triangle") == 0) return 1500;
+    return 500;
+}
+
+static void stem(const cbvh_vecgen_spec *s, char *buf, size_t n) {
+    if (s->unit->uses_encoding)
+        snprintf(buf, n, "%s-N%d-ms%d-%s", s->unit->name, s->cfg.params.quant_bits, s->cfg.params.min_scale,
+                 cbvh_encoding_name(s->cfg.enc));
+    else
+        snprintf(buf, n, "%s-N%d-ms%d", s->unit->name, s->cfg.params.quant_bits, s->cfg.params.min_scale);
+}
+
+void cbvh_vecgen_filename(const cbvh_vecgen_spec *s, char *buf, size_t n) {
+    char st[128];
+    stem(s, st, sizeof st);
+    snprintf(buf, n, "%s%s.vec", st, s->level >= 2 ? "-L2" : "");
+}
+
+int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
+    memset(vf, 0, sizeof *vf);
+    gen_t g;
+    memset(&g, 0, sizeof g);
+    g.spec = s;
+    s->unit->layout(&s->cfg, &g.lay);
+    g.N = s->cfg.params.quant_bits;
+    g.ms = s->cfg.params.min_scale;
+    g.mask = (1u << g.N) - 1u;
+    /* One stream per file: the seed mixed with the file's stem (FNV-1a), the
+     * same for both levels so level 2 extends level 1. */
+    char st[128];
+    stem(s, st, sizeof st);
+    uint64_t h = UINT64_C(0xCBF29CE484222325);
+    for (const char *c = st; *c; c++) h = (h ^ (uint8_t)*c) * UINT64_C(0x100000001B3);
+    rng_seed(&g.rng, s->seed ^ h);
+
+    size_t target = level1_target(s->unit);
+    void (*fn)(gen_t *, size_t) = NULL;
+    if (strcmp(s->unit->name, "scale_estimate") == 0) fn = gen_estimate;
+    else if (strcmp(s->unit->name, "axis_compress") == 0) fn = gen_compress;
+    else if (strcmp(s->unit->name, "axis_decode") == 0) fn = gen_decode;
+    else if (strcmp(s->unit->name, "nodepair_encode") == 0) fn = gen_encode_pair;
+    else if (strcmp(s->unit->name, "nodepair_decode") == 0) fn = gen_decode_pair;
+    else if (strcmp(s->unit->name, "ray_box") == 0) fn = gen_ray_box;
+    else if (strcmp(s->unit->name, "ray_triangle") == 0) fn = gen_ray_triangle;
+    if (!fn) return -1;
+    fn(&g, target);
+    if (s->level >= 2) {
+        g.random_only = 1;
+        fn(&g, g.n + CBVH_VECGEN_LEVEL2_RANDOM);
+    }
+    if (g.oom) {
+        free(g.in);
+        return -1;
+    }
+    uint32_t *out = malloc((g.n ? g.n : 1) * (size_t)g.lay.n_out * sizeof *out);
+    if (!out) {
+        free(g.in);
+        return -1;
+    }
+    for (size_t i = 0; i < g.n; i++)
+        s->unit->eval(&s->cfg, g.in + i * (size_t)g.lay.n_in, out + i * (size_t)g.lay.n_out);
+    vf->unit = s->unit;
+    vf->cfg = s->cfg;
+    if (!s->unit->uses_encoding) vf->cfg.enc = CBVH_ENC_MODULO;
+    vf->level = s->level;
+    vf->seed = s->seed;
+    vf->generator = CBVH_VECGEN_VERSION;
+    vf->layout = g.lay;
+    vf->count = g.n;
+    vf->first_line = 0;
+    vf->in = g.in;
+    vf->out = out;
+    return 0;
+}
+
+/* The traversal units do not depend on N or min_scale: one file (N = 6) in the default set. */
+static int is_ray_unit(const cbvh_unit *u) { return strncmp(u->name, "ray_", 4) == 0; }
+static int is_axis_unit(const cbvh_unit *u) { return strncmp(u->name, "nodepair", 8) != 0 && !is_ray_unit(u); }
+
+size_t cbvh_vecgen_specs(const cbvh_vecgen_select *sel, cbvh_vecgen_spec *out, size_t max) {
+    size_t n = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        /* pass 0: the N sweep; pass 1: the extra minimum scales (default set only) */
+        if (pass == 1 && (sel->bits || sel->ms_given)) break;
+        for (int u = 0; u < cbvh_unit_count; u++) {
+            const cbvh_unit *unit = cbvh_units[u];
+            if (sel->unit && sel->unit != unit) continue;
+            if (pass == 1 && !is_axis_unit(unit)) continue;
+            static const int extra_ms[] = {-126, -10};
+            int nlo = sel->bits ? sel->bits : CBVH_N_MIN, nhi = sel->bits ? sel->bits : CBVH_N_MAX;
+            if (pass == 1) nlo = nhi = 6;
+            if (is_ray_unit(unit) && !sel->bits) nlo = nhi = 6;
+            for (int bits = nlo; bits <= nhi; bits++)
+                for (int m = 0; m < (pass == 1 ? 2 : 1); m++)
+                    for (int e = 0; e < (unit->uses_encoding ? 2 : 1); e++) {
+                        cbvh_encoding enc = e ? CBVH_ENC_RELATIVE : CBVH_ENC_MODULO;
+                        if (unit->uses_encoding && sel->enc_given && enc != sel->enc) continue;
+                        if (n < max) {
+                            cbvh_vecgen_spec *s = &out[n];
+                            s->unit = unit;
+                            s->cfg.params.quant_bits = bits;
+                            s->cfg.params.min_scale = pass == 1 ? extra_ms[m]
+                                                      : sel->ms_given ? sel->min_scale
+                                                                      : CBVH_MIN_SCALE_DEFAULT;
+                            s->cfg.enc = enc;
+                            s->level = sel->level;
+                            s->seed = sel->seed;
+                        }
+                        n++;
+                    }
+        }
+    }
+    return n;
+}

@@ -1,0 +1,348 @@
+/* `cbvh vectors check`: MANIFEST first, then every vector on a backend. */
+#include "vectors_check.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "backend.h"
+#include "manifest.h"
+#include "vecfile.h"
+
+/* ---- the work list ---------------------------------------------------------- */
+
+typedef struct {
+    char **path;
+    size_t n, cap;
+} list_t;
+
+static int list_add(list_t *l, const char *p) {
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? 2 * l->cap : 128;
+        char **np = realloc(l->path, cap * sizeof *np);
+        if (!np) return -1;
+        l->path = np;
+        l->cap = cap;
+    }
+    l->path[l->n] = strdup(p);
+    return l->path[l->n] ? (int)(l->n++, 0) : -1;
+}
+
+static void list_free(list_t *l) {
+    for (size_t i = 0; i < l->n; i++) free(l->path[i]);
+    free(l->path);
+}
+
+static int ends_with(const char *s, const char *suffix) {
+    size_t n = strlen(s), k = strlen(suffix);
+    return n >= k && strcmp(s + n - k, suffix) == 0;
+}
+
+/* A single file: verified against the MANIFEST next to it when there is one. */
+static int verify_single(const char *path, FILE *log, char *err, size_t errlen) {
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    if (slash) {
+        size_t n = (size_t)(slash - path);
+        if (n >= sizeof dir) n = sizeof dir - 1;
+        memcpy(dir, path, n);
+        dir[n ? n : 1] = '\0';
+        if (n == 0) dir[0] = '/';
+    } else {
+        strcpy(dir, ".");
+    }
+    cbvh_manifest m;
+    int rc = cbvh_manifest_load(dir, &m, err, errlen);
+    if (rc < 0) return -1;
+    if (rc == 1) {
+        fprintf(log, "cbvh: note: no MANIFEST next to %s; its SHA-256 is not verified\n", path);
+        return 0;
+    }
+    const cbvh_manifest_entry *e = cbvh_manifest_find(&m, base);
+    if (!e) {
+        snprintf(err, errlen, "%.400s: not listed in %.400s/MANIFEST", path, dir);
+        cbvh_manifest_free(&m);
+        return -1;
+    }
+    char *buf;
+    size_t len;
+    if (cbvh_read_file(path, &buf, &len, err, errlen) != 0) {
+        cbvh_manifest_free(&m);
+        return -1;
+    }
+    char hex[CBVH_SHA256_HEX_LEN + 1];
+    int hrc = cbvh_sha256_hex(buf, len, hex);
+    free(buf);
+    if (hrc != 0 || strcmp(hex, e->sha256) != 0) {
+        snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path, e->sha256,
+                 hrc ? "?" : hex);
+        cbvh_manifest_free(&m);
+        return -1;
+    }
+    cbvh_manifest_free(&m);
+    return 0;
+}
+
+static int collect(const char *const *paths, int npaths, FILE *log, list_t *files, char *err, size_t errlen) {
+    for (int i = 0; i < npaths; i++) {
+        struct stat st;
+        if (stat(paths[i], &st) != 0) {
+            snprintf(err, errlen, "%s: %s", paths[i], strerror(errno));
+            return -1;
+        }
+        if (S_ISDIR(st.st_mode)) {
+            char d[4096];
+            snprintf(d, sizeof d, "%s", paths[i]);
+            for (size_t k = strlen(d); k > 1 && d[k - 1] == '/'; k--) d[k - 1] = '\0'; /* "vectors/" -> "vectors" */
+            cbvh_manifest m;
+            if (cbvh_manifest_verify_dir(d, &m, err, errlen) != 0) return -1;
+            for (size_t k = 0; k < m.n; k++) {
+                if (!ends_with(m.e[k].name, ".vec")) continue;
+                char p[4096];
+                snprintf(p, sizeof p, "%.3800s/%s", d, m.e[k].name);
+                if (list_add(files, p) != 0) {
+                    cbvh_manifest_free(&m);
+                    snprintf(err, errlen, "out of memory");
+                    return -1;
+                }
+            }
+            cbvh_manifest_free(&m);
+        } else {
+            if (verify_single(paths[i], log, err, errlen) != 0) return -1;
+            if (list_add(files, paths[i]) != 0) {
+                snprintf(err, errlen, "out of memory");
+                return -1;
+            }
+        }
+    }
+    if (files->n == 0) {
+        snprintf(err, errlen, "no vector files to check");
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- reporting -------------------------------------------------------------- */
+
+static const char *const status_bit_names[] = {"NAN_INF", "INVERTED", "BAD_SCALE", "BAD_PARAM",
+                                               "BAD_CODE", "BAD_FORMAT", "NO_FIT"};
+
+/* Readable form of a field value: scales in decimal, status bits by name. */
+static void annotate(const char *name, uint32_t v, char *buf, size_t n) {
+    buf[0] = '\0';
+    if (ends_with(name, "scale")) {
+        snprintf(buf, n, " (%d)", cbvh_scale_from_word(v));
+    } else if (strcmp(name, "status") == 0 && v) {
+        size_t o = (size_t)snprintf(buf, n, " (");
+        for (int b = 0; b < 7 && o < n; b++)
+            if (v >> b & 1u) o += (size_t)snprintf(buf + o, n - o, "%s%s", o > 2 ? "|" : "", status_bit_names[b]);
+        if (o < n) snprintf(buf + o, n - o, ")");
+    }
+}
+
+static void describe_cfg(const cbvh_vecfile *vf, char *buf, size_t n) {
+    snprintf(buf, n, "N=%d min_scale=%d%s%s", vf->cfg.params.quant_bits, vf->cfg.params.min_scale,
+             vf->unit->uses_encoding ? " " : "", vf->unit->uses_encoding ? cbvh_encoding_name(vf->cfg.enc) : "");
+}
+
+static void print_mismatch_text(FILE *f, const char *path, const cbvh_vecfile *vf, size_t i, const uint32_t *act) {
+    const cbvh_layout *l = &vf->layout;
+    const uint32_t *in = vf->in + i * (size_t)l->n_in, *exp = vf->out + i * (size_t)l->n_out;
+    char cfg[96], note[128];
+    describe_cfg(vf, cfg, sizeof cfg);
+    fprintf(f, "MISMATCH %s:%zu: %s (%s)\n  inputs:", path, vf->first_line + i, vf->unit->name, cfg);
+    for (int k = 0; k < l->n_in; k++) {
+        annotate(l->in[k].name, in[k], note, sizeof note);
+        fprintf(f, " %s=%0*" PRIX32 "%s", l->in[k].name, l->in[k].hex_digits, in[k], note);
+    }
+    fprintf(f, "\n");
+    for (int k = 0; k < l->n_out; k++) {
+        int d = l->out[k].hex_digits;
+        char ne[128];
+        annotate(l->out[k].name, exp[k], ne, sizeof ne);
+        annotate(l->out[k].name, act[k], note, sizeof note);
+        fprintf(f, "  %-18s expected %0*" PRIX32 "%s  actual %0*" PRIX32 "%s%s\n", l->out[k].name, d, exp[k], ne, d,
+                act[k], note, exp[k] != act[k] ? "   <-- differs" : "");
+    }
+}
+
+static void json_str(FILE *f, const char *s) {
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+        else if (c < 0x20) fprintf(f, "\\u%04x", c);
+        else fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void json_mismatch(FILE *f, const char *path, const cbvh_vecfile *vf, size_t i, const uint32_t *act) {
+    const cbvh_layout *l = &vf->layout;
+    const uint32_t *in = vf->in + i * (size_t)l->n_in, *exp = vf->out + i * (size_t)l->n_out;
+    fprintf(f, "{\"file\": ");
+    json_str(f, path);
+    fprintf(f, ", \"line\": %zu, \"unit\": \"%s\", \"inputs\": {", vf->first_line + i, vf->unit->name);
+    for (int k = 0; k < l->n_in; k++)
+        fprintf(f, "%s\"%s\": \"%0*" PRIX32 "\"", k ? ", " : "", l->in[k].name, l->in[k].hex_digits, in[k]);
+    fprintf(f, "}, \"outputs\": [");
+    for (int k = 0; k < l->n_out; k++)
+        fprintf(f, "%s{\"field\": \"%s\", \"expected\": \"%0*" PRIX32 "\", \"actual\": \"%0*" PRIX32 "\", \"differs\": %s}",
+                k ? ", " : "", l->out[k].name, l->out[k].hex_digits, exp[k], l->out[k].hex_digits, act[k],
+                exp[k] != act[k] ? "true" : "false");
+    fprintf(f, "]}");
+}
+
+static double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- the check ------------------------------------------------------------ */
+
+int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_opts *opts) {
+    cbvh_check_opts o = *opts;
+    FILE *out = o.out ? o.out : stdout, *log = o.log ? o.log : stderr;
+    const char *spec = o.backend ? o.backend : "auto";
+    size_t batch = o.batch ? o.batch : CBVH_CHECK_BATCH;
+    cbvh_check_summary sum;
+    memset(&sum, 0, sizeof sum);
+    char err[1024] = "";
+    int rc = CBVH_CHECK_BAD_INPUT;
+    list_t files = {NULL, 0, 0};
+    cbvh_backend be;
+    memset(&be, 0, sizeof be);
+    int be_open = 0;
+    uint32_t *act = NULL;
+    size_t act_cap = 0;
+    int printed = 0, in_obj = 0;
+    double t0 = now();
+
+    if (collect(paths, npaths, log, &files, err, sizeof err) != 0) goto done;
+    char berr[512] = "";
+    fflush(out); /* keep the fallback note after anything already printed */
+    if (cbvh_backend_open(spec, &be, log, berr, sizeof berr) != 0) {
+        snprintf(err, sizeof err, "backend '%.100s': %s", spec, berr);
+        goto done;
+    }
+    be_open = 1;
+    snprintf(sum.backend, sizeof sum.backend, "%s", be.label);
+    if (o.json) {
+        fprintf(out, "{\"backend\": ");
+        json_str(out, be.label);
+        fprintf(out, ", \"files\": [");
+    } else {
+        fprintf(out, "backend: %s\n", be.label);
+    }
+    t0 = now();
+    for (size_t fi = 0; fi < files.n; fi++) {
+        const char *path = files.path[fi];
+        cbvh_vecfile vf;
+        if (cbvh_vecfile_load(path, &vf, err, sizeof err) != CBVH_VEC_OK) goto done_json;
+        const cbvh_layout *l = &vf.layout;
+        size_t need = batch * (size_t)(l->n_out ? l->n_out : 1);
+        if (need > act_cap) {
+            uint32_t *na = realloc(act, need * sizeof *na);
+            if (!na) {
+                snprintf(err, sizeof err, "out of memory");
+                cbvh_vecfile_free(&vf);
+                goto done_json;
+            }
+            act = na;
+            act_cap = need;
+        }
+        size_t pass = 0, fail = 0;
+        int shown_here = 0;
+        in_obj = o.json;
+        if (o.json) {
+            fprintf(out, "%s{\"file\": ", fi ? ", " : "");
+            json_str(out, path);
+            fprintf(out, ", \"unit\": \"%s\", \"mismatches\": [", vf.unit->name);
+        }
+        for (size_t off = 0; off < vf.count; off += batch) {
+            size_t cnt = vf.count - off < batch ? vf.count - off : batch;
+            char berr[512] = "";
+            memset(act, 0, cnt * (size_t)l->n_out * sizeof *act);
+            if (be.ops->run(&be, vf.unit, &vf.cfg, vf.in + off * (size_t)l->n_in, act, cnt, berr, sizeof berr) != 0) {
+                snprintf(err, sizeof err, "%s: backend %s failed: %s", path, be.label, berr);
+                cbvh_vecfile_free(&vf);
+                goto done_json;
+            }
+            for (size_t i = 0; i < cnt; i++) {
+                const uint32_t *a = act + i * (size_t)l->n_out, *e = vf.out + (off + i) * (size_t)l->n_out;
+                if (memcmp(a, e, (size_t)l->n_out * sizeof *a) == 0) {
+                    pass++;
+                    continue;
+                }
+                fail++;
+                if (printed < o.max_errors && !o.json) print_mismatch_text(out, path, &vf, off + i, a);
+                if (printed < o.max_errors && o.json) {
+                    fprintf(out, "%s", shown_here ? ", " : "");
+                    json_mismatch(out, path, &vf, off + i, a);
+                    shown_here++;
+                }
+                printed++;
+            }
+        }
+        if (o.json) {
+            fprintf(out, "], \"passed\": %zu, \"failed\": %zu}", pass, fail);
+            in_obj = 0;
+        } else if (!o.quiet || fail) {
+            fprintf(out, "%s: %zu passed, %zu failed\n", path, pass, fail);
+        }
+        sum.files++;
+        sum.passed += pass;
+        sum.failed += fail;
+        cbvh_vecfile_free(&vf);
+    }
+    rc = sum.failed ? CBVH_CHECK_MISMATCH : CBVH_CHECK_PASS;
+done_json:
+    sum.seconds = now() - t0;
+    sum.vectors_per_second = sum.seconds > 0 ? (double)(sum.passed + sum.failed) / sum.seconds : 0;
+    if (o.json) {
+        if (in_obj) fprintf(out, "]}");
+        fprintf(out, "], \"total\": {\"files\": %zu, \"passed\": %zu, \"failed\": %zu, \"seconds\": %.6f, "
+                     "\"vectors_per_second\": %.0f}, \"mismatches_shown\": %d, \"status\": %d",
+                sum.files, sum.passed, sum.failed, sum.seconds, sum.vectors_per_second,
+                printed < o.max_errors ? printed : o.max_errors, rc);
+        if (rc == CBVH_CHECK_BAD_INPUT) {
+            fprintf(out, ", \"error\": ");
+            json_str(out, err);
+        }
+        fprintf(out, "}\n");
+    } else if (rc != CBVH_CHECK_BAD_INPUT) {
+        if (printed > o.max_errors)
+            fprintf(out, "(%d more mismatches not shown; --max-errors raises the limit)\n", printed - o.max_errors);
+        fprintf(out, "total: %zu files, %zu passed, %zu failed (%zu vectors in %.3f s, %.0f vectors/s)\n", sum.files,
+                sum.passed, sum.failed, sum.passed + sum.failed, sum.seconds, sum.vectors_per_second);
+    }
+    goto finish;
+done:
+    if (o.json) {
+        fprintf(out, "{\"status\": %d, \"error\": ", rc);
+        json_str(out, err);
+        fprintf(out, "}\n");
+    }
+finish:
+    if (rc == CBVH_CHECK_BAD_INPUT) fprintf(log, "cbvh vectors check: %s\n", err);
+    if (be_open) cbvh_backend_close(&be);
+    free(act);
+    list_free(&files);
+    if (o.summary) *o.summary = sum;
+    return rc;
+}
+
+int cbvh_vectors_check_dir(const char *dir, const char *backend_spec, FILE *out) {
+    cbvh_check_opts o;
+    memset(&o, 0, sizeof o);
+    o.backend = backend_spec;
+    o.max_errors = 20;
+    o.out = out;
+    const char *paths[1] = {dir};
+    return cbvh_vectors_check(paths, 1, &o);
+}

@@ -1,0 +1,43 @@
+# A copy of a committed vector file with one expected output flipped (and its
+# MANIFEST updated) must make `cbvh vectors check` exit 1 and print the
+# mismatch with the unit's field names.
+file(REMOVE_RECURSE "${SCRATCH}")
+file(MAKE_DIRECTORY "${SCRATCH}")
+set(name scale_estimate-N6-ms-30.vec)
+file(STRINGS "${COMMITTED}/${name}" lines)
+# Vector 0 is line 12 (list index 11): "lb ub scale status"; flip status 00 -> 40.
+list(GET lines 11 v)
+string(REGEX MATCH "[0-9A-F][0-9A-F] [0-9A-F][0-9A-F]$" tail "${v}")
+string(SUBSTRING "${tail}" 0 3 scale)
+string(SUBSTRING "${tail}" 3 2 status)
+if(status STREQUAL "40")
+    set(status "00")
+else()
+    set(status "40")
+endif()
+string(SUBSTRING "${v}" 0 18 keep)
+set(flipped "${keep}${scale}${status}")
+list(REMOVE_AT lines 11)
+list(INSERT lines 11 "${flipped}")
+string(REPLACE ";" "\n" text "${lines}")
+file(WRITE "${SCRATCH}/${name}" "${text}\n")
+file(SHA256 "${SCRATCH}/${name}" h)
+file(WRITE "${SCRATCH}/MANIFEST" "${h}  ${name}\n")
+execute_process(COMMAND "${CBVH}" vectors check --backend model "${SCRATCH}" RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+set(all "${out}${err}")
+if(NOT rc EQUAL 1)
+    message(FATAL_ERROR "exit status ${rc}, expected 1:\n${all}")
+endif()
+foreach(re "MISMATCH [^\n]*${name}:12: scale_estimate" "inputs: lb=[0-9A-F]+ ub=[0-9A-F]+"
+           "status +expected ${status}[^\n]*<-- differs" "scale +expected [^\n]*actual [^\n]*\n"
+           "1 failed" "total: 1 files, [0-9]+ passed, 1 failed")
+    if(NOT all MATCHES "${re}")
+        message(FATAL_ERROR "output does not match '${re}':\n${all}")
+    endif()
+endforeach()
+if(all MATCHES "scale +expected [^\n]*<-- differs")
+    message(FATAL_ERROR "the unchanged scale field is marked as differing:\n${all}")
+endif()
+file(REMOVE_RECURSE "${SCRATCH}")
+message(STATUS "flipped status of ${name}:12 detected")
