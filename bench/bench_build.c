@@ -1,0 +1,98 @@
+/* Build benchmark (issue 3): float LBVH throughput, streaming bottom-up CBVH
+ * build vs the float LBVH build in the same run, top-down compression, and
+ * CBVH bytes vs float BVH bytes.
+ *
+ * usage: bench_build [--reps R] [SCENE...]
+ *   SCENE as for `cbvh study` (file or proc:NAME[:SIZE]); default: the bundled
+ *   bunny and proc:instanced (10.24 M triangles).
+ * Times are the best of R repetitions (default 3), one core. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cbvh/bvh.h"
+#include "cbvh/cbvh_tree.h"
+#include "scene_load.h"
+
+#ifndef CBVH_SCENES_DIR
+#define CBVH_SCENES_DIR "scenes"
+#endif
+
+static double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void die(const char *what, const char *err) {
+    fprintf(stderr, "bench_build: %s: %s\n", what, err);
+    exit(1);
+}
+
+int main(int argc, char **argv) {
+    int reps = 3;
+    const char *specs[64];
+    int ns = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
+            reps = atoi(argv[++i]);
+            if (reps < 1 || reps > 100) die("--reps", "must be 1..100");
+        } else if (argv[i][0] == '-') {
+            fprintf(stderr, "usage: bench_build [--reps R] [SCENE...]\n");
+            return 2;
+        } else if (ns < 64) {
+            specs[ns++] = argv[i];
+        }
+    }
+    if (!ns) {
+        specs[ns++] = CBVH_SCENES_DIR "/bunny-small.obj";
+        specs[ns++] = "proc:instanced";
+    }
+    char err[512];
+    printf("%-24s %10s %10s %9s %9s %9s %7s %7s %11s %11s %6s\n", "scene", "triangles", "lbvh_ms", "Mtri/s",
+           "lbvh+bu", "lbvh+td", "bu/lbvh", "td/lbvh", "cbvh_bytes", "float_bytes", "ratio");
+    for (int i = 0; i < ns; i++) {
+        cbvh_scene s;
+        if (cbvh_scene_open(specs[i], &s, err, sizeof err)) die(specs[i], err);
+        cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 4, 0};
+        double best_l = 1e30, best_bu = 1e30, best_td = 1e30;
+        size_t cb = 0, fb = 0;
+        for (int r = 0; r < reps; r++) {
+            cbvh_bvh b;
+            cbvh_tree t;
+            cbvh_bu_stats st;
+            /* float LBVH alone */
+            double t0 = now();
+            if (cbvh_build_lbvh(&s, &b, err, sizeof err)) die(specs[i], err);
+            double t1 = now();
+            cbvh_bvh_free(&b);
+            /* LBVH + streaming bottom-up compression (the CBVH build) */
+            double t2 = now();
+            if (cbvh_build_lbvh(&s, &b, err, sizeof err)) die(specs[i], err);
+            if (cbvh_compress_bottomup(&b, NULL, &o, &t, &st, err, sizeof err)) die(specs[i], err);
+            double t3 = now();
+            cb = cbvh_tree_bytes(&t);
+            fb = cbvh_bvh_bytes(&b);
+            cbvh_tree_free(&t);
+            /* LBVH + top-down compression (build-then-compress baseline) */
+            double t4 = now();
+            cbvh_bvh_free(&b);
+            if (cbvh_build_lbvh(&s, &b, err, sizeof err)) die(specs[i], err);
+            if (cbvh_compress_topdown(&b, &o, &t, err, sizeof err)) die(specs[i], err);
+            double t5 = now();
+            cbvh_tree_free(&t);
+            cbvh_bvh_free(&b);
+            if (t1 - t0 < best_l) best_l = t1 - t0;
+            if (t3 - t2 < best_bu) best_bu = t3 - t2;
+            if (t5 - t4 < best_td) best_td = t5 - t4;
+        }
+        printf("%-24.24s %10u %10.2f %9.2f %9.2f %9.2f %7.2f %7.2f %11zu %11zu %6.3f\n", s.name, s.ntris,
+               1e3 * best_l, s.ntris / best_l / 1e6, 1e3 * best_bu, 1e3 * best_td, best_bu / best_l, best_td / best_l,
+               cb, fb, (double)cb / (double)fb);
+        fflush(stdout);
+        cbvh_scene_free(&s);
+    }
+    return 0;
+}

@@ -1,0 +1,29 @@
+/* Scene loading for the host tool: mesh files through assimp, or procedural
+ * scenes by name.  Every failure is a one-line message in err and -1. */
+#ifndef CBVH_HOST_SCENE_LOAD_H
+#define CBVH_HOST_SCENE_LOAD_H
+
+#include <stddef.h>
+
+#include "cbvh/scene.h"
+
+/* Import a mesh file (OBJ, PLY, OFF, STL, glTF/GLB, ... anything assimp
+ * reads): all meshes, node transforms applied, triangles only, plus glTF
+ * morph targets and the first morph animation.  Rejects a missing file,
+ * unreadable/malformed data, out-of-range indices, non-finite vertices, and
+ * files without triangles. */
+int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errlen);
+
+/* Procedural scenes (names for cbvh_scene_open):
+ *   cloth      finely tessellated plane at z = -0.4 (degenerate z axis) with a
+ *              draped bump in the middle; `size` = grid cells per side (0: 256)
+ *   far        small sphere (radius 0.01) far from the origin (~(1000,-2000,3000))
+ *   instanced  grid of sphere instances, >= 10M triangles for size 0
+ *              (size = instances per side; 40 -> 10.2M triangles)
+ *   wave       a 64x64 grid surface for the procedural twist/wave refit */
+int cbvh_scene_procedural(const char *name, unsigned size, cbvh_scene *out, char *err, size_t errlen);
+
+/* One entry point: "proc:NAME[:SIZE]" -> procedural, anything else -> file. */
+int cbvh_scene_open(const char *spec, cbvh_scene *out, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,632 @@
+/* Scenes, float builders and CBVH compressors (issue 3). */
+#include <float.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "cbvh/bvh.h"
+#include "cbvh/cbvh_tree.h"
+#include "scene_load.h"
+
+#ifndef CBVH_SCENES_DIR
+#error "CBVH_SCENES_DIR must name the scenes folder"
+#endif
+
+static char errbuf[512];
+
+/* ---- helpers ----------------------------------------------------------- */
+
+static char *write_temp(const char *suffix, const void *data, size_t len) {
+    static char path[256];
+    snprintf(path, sizeof path, "/tmp/cbvh_test_%d_%s", (int)getpid(), suffix);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    if (len) assert_int_equal(fwrite(data, 1, len, f), len);
+    fclose(f);
+    return path;
+}
+
+static int import_text(const char *suffix, const char *text, cbvh_scene *s) {
+    char *p = write_temp(suffix, text, strlen(text));
+    int rc = cbvh_scene_import(p, s, errbuf, sizeof errbuf);
+    remove(p);
+    return rc;
+}
+
+static void load_bunny(cbvh_scene *s) {
+    int rc = cbvh_scene_import(CBVH_SCENES_DIR "/bunny-small.obj", s, errbuf, sizeof errbuf);
+    if (rc) fail_msg("%s", errbuf);
+}
+
+static uint32_t rng_state = 12345u;
+static uint32_t rnd(void) {
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 17;
+    rng_state ^= rng_state << 5;
+    return rng_state;
+}
+static float rndf(void) { return (float)(rnd() & 0xFFFFFF) / 16777216.0f; }
+
+static void random_scene(cbvh_scene *s, uint32_t n, float spread, float size) {
+    memset(s, 0, sizeof *s);
+    snprintf(s->name, sizeof s->name, "random");
+    s->tris = malloc(n * sizeof *s->tris);
+    s->ntris = n;
+    for (uint32_t i = 0; i < n; i++) {
+        float c[3] = {spread * (rndf() - 0.5f), spread * (rndf() - 0.5f), spread * (rndf() - 0.5f)};
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) s->tris[i].v[v][a] = c[a] + size * (rndf() - 0.5f);
+    }
+}
+
+static void no_error(int rc) {
+    if (rc) fail_msg("%s", errbuf);
+}
+
+/* ---- import ------------------------------------------------------------ */
+
+static void test_import_bunny(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    assert_int_equal(s.ntris, 3674);
+    float lo[3], hi[3];
+    cbvh_scene_bounds(&s, lo, hi);
+    for (int a = 0; a < 3; a++) assert_true(lo[a] < hi[a] && hi[a] - lo[a] < 100.0f);
+    cbvh_scene_free(&s);
+}
+
+static void test_import_formats(void **st) {
+    (void)st;
+    cbvh_scene s;
+    const char *off = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+    no_error(import_text("a.off", off, &s));
+    assert_int_equal(s.ntris, 2);
+    assert_float_equal(s.tris[1].v[2][1], 1.0f, 0.0f);
+    cbvh_scene_free(&s);
+    const char *ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n2 0 0\n0 3 0\n3 0 1 2\n";
+    no_error(import_text("a.ply", ply, &s));
+    assert_int_equal(s.ntris, 1);
+    assert_float_equal(s.tris[0].v[2][1], 3.0f, 0.0f);
+    cbvh_scene_free(&s);
+    const char *stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
+                      "endfacet\nendsolid t\n";
+    no_error(import_text("a.stl", stl, &s));
+    assert_int_equal(s.ntris, 1);
+    cbvh_scene_free(&s);
+    /* A quad is triangulated. */
+    no_error(import_text("q.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", &s));
+    assert_int_equal(s.ntris, 2);
+    cbvh_scene_free(&s);
+}
+
+static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+static void base64(const uint8_t *in, size_t n, char *out) {
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
+        out[o++] = b64[v >> 18 & 63];
+        out[o++] = b64[v >> 12 & 63];
+        out[o++] = i + 1 < n ? b64[v >> 6 & 63] : '=';
+        out[o++] = i + 2 < n ? b64[v & 63] : '=';
+    }
+    out[o] = 0;
+}
+
+/* glTF with one triangle, one morph target (+1 in z for every vertex), and a
+ * weight animation 0 -> 1 over one second; node translated by +10 in x. */
+static void test_import_gltf_morph(void **st) {
+    (void)st;
+    float buf[22] = {0, 0, 0, 1, 0, 0, 0, 1, 0, /* positions */
+                     0, 0, 1, 0, 0, 1, 0, 0, 1, /* target deltas */
+                     0, 1,                      /* times */
+                     0, 1};                     /* weights */
+    char enc[200], gltf[4096];
+    base64((const uint8_t *)buf, sizeof buf, enc);
+    snprintf(gltf, sizeof gltf,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+             "\"nodes\":[{\"mesh\":0,\"translation\":[10,0,0]}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":1}]}],"
+             "\"weights\":[0]}],"
+             "\"buffers\":[{\"byteLength\":88,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,"
+             "\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":80,"
+             "\"byteLength\":8}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],"
+             "\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,1],"
+             "\"max\":[0,0,1]},{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\",\"min\":[0],"
+             "\"max\":[1]},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"
+             "\"animations\":[{\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}],"
+             "\"samplers\":[{\"input\":2,\"output\":3,\"interpolation\":\"LINEAR\"}]}]}",
+             enc);
+    cbvh_scene s;
+    no_error(import_text("m.gltf", gltf, &s));
+    assert_int_equal(s.ntris, 1);
+    assert_float_equal(s.tris[0].v[1][0], 11.0f, 0.0f); /* node transform applied */
+    assert_int_equal(s.nmorph, 1);
+    assert_true(s.nkeys >= 2);
+    assert_float_equal(cbvh_scene_duration(&s), 1.0f, 1e-6f);
+    cbvh_tri fr;
+    cbvh_scene_frame(&s, 0.5f, &fr);
+    assert_float_equal(fr.v[0][2], 0.5f, 1e-6f);
+    cbvh_scene_frame(&s, 1.0f, &fr);
+    assert_float_equal(fr.v[2][2], 1.0f, 1e-6f);
+    assert_float_equal(fr.v[2][0], 10.0f, 1e-6f);
+    cbvh_scene_free(&s);
+}
+
+static void expect_import_error(const char *suffix, const char *text, const char *needle) {
+    cbvh_scene s;
+    errbuf[0] = 0;
+    assert_int_equal(import_text(suffix, text, &s), -1);
+    assert_null(s.tris);
+    assert_int_equal(s.ntris, 0);
+    assert_null(strchr(errbuf, '\n'));
+    if (needle && !strstr(errbuf, needle)) fail_msg("error '%s' lacks '%s'", errbuf, needle);
+}
+
+static void test_import_errors(void **st) {
+    (void)st;
+    expect_import_error("e.obj", "", "empty");
+    expect_import_error("n.obj", "v 0 0 0\nv 1 0 0\n", NULL);
+    expect_import_error("r.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", NULL);
+    expect_import_error("f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n", NULL);
+    expect_import_error("i.off", "OFF\n3 1 0\n0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n", NULL);
+    expect_import_error("x.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "out of range");
+    expect_import_error("m.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", "out of range");
+    expect_import_error("t.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", NULL);
+    expect_import_error("r.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                        "0 0 0\n2 0 0\n0 3 0\n3 0 1 5\n", "out of range");
+    expect_import_error("g.ply", "ply\nformat ascii 1.0\nelement vertex 900\nend_header\n1 2\n", NULL);
+    expect_import_error("b.gltf", "{\"asset\":{\"version\":\"2.0\"}, \"meshes\":[{]}", NULL);
+    cbvh_scene s;
+    assert_int_equal(cbvh_scene_import("/nonexistent/dir/x.obj", &s, errbuf, sizeof errbuf), -1);
+    assert_non_null(strstr(errbuf, "cannot open"));
+    assert_int_equal(cbvh_scene_open("proc:nosuch", &s, errbuf, sizeof errbuf), -1);
+    assert_int_equal(cbvh_scene_open("proc:cloth:0", &s, errbuf, sizeof errbuf), -1);
+}
+
+static void test_scene_validate(void **st) {
+    (void)st;
+    cbvh_scene s;
+    random_scene(&s, 10, 1.0f, 0.1f);
+    assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), 0);
+    s.tris[7].v[1][2] = INFINITY;
+    assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), -1);
+    assert_non_null(strstr(errbuf, "triangle 7"));
+    cbvh_bvh b;
+    assert_int_equal(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf), -1);
+    assert_int_equal(cbvh_build_sah(&s, 0, 0, &b, errbuf, sizeof errbuf), -1);
+    s.ntris = 0;
+    assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), -1);
+    cbvh_scene_free(&s);
+}
+
+/* ---- float builders ---------------------------------------------------- */
+
+static void test_lbvh_valid(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+    uint32_t leaves, inner;
+    cbvh_bvh_counts(&b, &leaves, &inner);
+    assert_int_equal(leaves, inner + 1);
+    assert_true(leaves > s.ntris / 2 && leaves <= s.ntris);
+    /* Root box is the scene box. */
+    float lo[3], hi[3];
+    cbvh_scene_bounds(&s, lo, hi);
+    for (int a = 0; a < 3; a++) {
+        assert_true(b.nodes[b.root].lo[a] == lo[a]);
+        assert_true(b.nodes[b.root].hi[a] == hi[a]);
+    }
+    /* Corrupting a box makes the check fail (the check can fail). */
+    b.nodes[b.nodes[b.root].child[0]].hi[1] += 1.0f;
+    assert_int_equal(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf), -1);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+static void test_lbvh_equal_codes_share_leaf(void **st) {
+    (void)st;
+    cbvh_scene s;
+    random_scene(&s, 64, 10.0f, 0.5f);
+    /* Triangles 10..19 identical to 5: same centroid, same Morton code. */
+    for (int i = 10; i < 20; i++) s.tris[i] = s.tris[5];
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+    int found = 0;
+    for (uint32_t i = 0; i < b.nnodes; i++) {
+        const cbvh_bvh_node *n = &b.nodes[i];
+        if (!cbvh_bvh_is_leaf(n)) continue;
+        int has5 = 0;
+        for (uint32_t j = 0; j < n->count; j++) has5 |= b.prims[n->first + j] == 5;
+        if (has5) {
+            assert_true(n->count >= 11);
+            for (uint32_t j = 0; j < n->count; j++) {
+                uint32_t p = b.prims[n->first + j];
+                assert_true(p == 5 || (p >= 10 && p < 20) || memcmp(&s.tris[p], &s.tris[5], sizeof s.tris[5]) != 0);
+            }
+            found = 1;
+        }
+    }
+    assert_true(found);
+    cbvh_bvh_free(&b);
+    /* All identical: a single leaf is the root. */
+    for (uint32_t i = 0; i < s.ntris; i++) s.tris[i] = s.tris[0];
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    assert_int_equal(b.nnodes, 1);
+    assert_int_equal(b.nodes[b.root].count, 64);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+static void test_sah_valid_and_better(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh sah, lb;
+    no_error(cbvh_build_sah(&s, 16, 4, &sah, errbuf, sizeof errbuf));
+    no_error(cbvh_bvh_check(&sah, &s, errbuf, sizeof errbuf));
+    no_error(cbvh_build_lbvh(&s, &lb, errbuf, sizeof errbuf));
+    double cs = cbvh_bvh_sah(&sah), cl = cbvh_bvh_sah(&lb);
+    assert_true(cs > 1.0 && cl > 1.0);
+    assert_true(cs < cl); /* SAH optimises the cost LBVH ignores */
+    for (uint32_t i = 0; i < sah.nnodes; i++)
+        if (cbvh_bvh_is_leaf(&sah.nodes[i])) assert_true(sah.nodes[i].count <= 4);
+    cbvh_bvh_free(&sah);
+    cbvh_bvh_free(&lb);
+    cbvh_scene_free(&s);
+}
+
+static void test_sah_cost_formula(void **st) {
+    (void)st;
+    /* Two unit-cube-ish leaves side by side: root [0,2]x[0,1]x[0,1] area 10,
+     * leaves area 6 each with 1 triangle: cost = 1 + 6/10 + 6/10 = 2.2. */
+    cbvh_bvh_node n[3] = {{{0, 0, 0}, {2, 1, 1}, {1, 2}, 0, 0},
+                          {{0, 0, 0}, {1, 1, 1}, {0, 0}, 0, 1},
+                          {{1, 0, 0}, {2, 1, 1}, {0, 0}, 1, 1}};
+    uint32_t prims[2] = {0, 1};
+    cbvh_bvh b = {n, 3, 0, prims, 2};
+    assert_float_equal(cbvh_bvh_sah(&b), 2.2, 1e-12);
+}
+
+/* ---- compressors ------------------------------------------------------- */
+
+static cbvh_compress_opts opts(int n, int min_scale, cbvh_encoding enc, int treelet) {
+    cbvh_compress_opts o = {{n, min_scale}, enc, treelet, 0};
+    return o;
+}
+
+/* Top-down and bottom-up on one float BVH: both decode to enclosing boxes and
+ * are bit-identical; treelets only move work on chip. */
+static void check_both(cbvh_bvh *b, int n, int min_scale, cbvh_encoding enc) {
+    cbvh_compress_opts o = opts(n, min_scale, enc, 1);
+    cbvh_tree td, bu;
+    cbvh_bu_stats stt;
+    no_error(cbvh_compress_topdown(b, &o, &td, errbuf, sizeof errbuf));
+    no_error(cbvh_tree_check(&td, b, errbuf, sizeof errbuf));
+    no_error(cbvh_compress_bottomup(b, NULL, &o, &bu, &stt, errbuf, sizeof errbuf));
+    no_error(cbvh_tree_check(&bu, b, errbuf, sizeof errbuf));
+    long d = cbvh_tree_diff(&td, &bu);
+    if (d != -1) fail_msg("N=%d min_scale=%d enc=%d: bottom-up differs from top-down at byte %ld", n, min_scale, enc, d);
+    uint64_t hsum = 0;
+    for (int i = 0; i < CBVH_BT_HIST; i++) hsum += stt.hist[i];
+    assert_true(hsum == stt.reencodes);
+    assert_true(stt.backtracks == stt.reencodes);
+    assert_true(stt.encodes == td.npairs);
+    uint64_t prev = stt.backtracks;
+    for (int m = 2; m <= 4; m++) {
+        cbvh_tree t2;
+        cbvh_bu_stats s2;
+        o.treelet_depth = m;
+        no_error(cbvh_compress_bottomup(b, NULL, &o, &t2, &s2, errbuf, sizeof errbuf));
+        assert_int_equal(cbvh_tree_diff(&td, &t2), -1);
+        assert_true(s2.reencodes == stt.reencodes);
+        uint64_t deep = 0;
+        for (int i = m; i < CBVH_BT_HIST; i++) deep += stt.hist[i];
+        assert_true(s2.backtracks == deep);
+        assert_true(s2.backtracks <= prev);
+        prev = s2.backtracks;
+        cbvh_tree_free(&t2);
+    }
+    cbvh_tree_free(&td);
+    cbvh_tree_free(&bu);
+}
+
+static void test_compress_bunny(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh lb, sah;
+    no_error(cbvh_build_lbvh(&s, &lb, errbuf, sizeof errbuf));
+    no_error(cbvh_build_sah(&s, 0, 0, &sah, errbuf, sizeof errbuf));
+    const int ns[] = {3, 4, 6, 7, 10};
+    for (size_t i = 0; i < sizeof ns / sizeof ns[0]; i++)
+        for (int e = 0; e < 2; e++) {
+            check_both(&lb, ns[i], -30, (cbvh_encoding)e);
+            check_both(&sah, ns[i], -126, (cbvh_encoding)e);
+        }
+    cbvh_bvh_free(&lb);
+    cbvh_bvh_free(&sah);
+    cbvh_scene_free(&s);
+}
+
+static void test_compress_hard_scenes(void **st) {
+    (void)st;
+    const char *specs[] = {"proc:cloth:48", "proc:far:16", "proc:wave:24"};
+    for (size_t i = 0; i < 3; i++) {
+        cbvh_scene s;
+        no_error(cbvh_scene_open(specs[i], &s, errbuf, sizeof errbuf));
+        cbvh_bvh b;
+        no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+        no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+        for (int e = 0; e < 2; e++) {
+            check_both(&b, 6, -126, (cbvh_encoding)e);
+            check_both(&b, 6, -30, (cbvh_encoding)e);
+            check_both(&b, 5, -10, (cbvh_encoding)e);
+        }
+        cbvh_bvh_free(&b);
+        cbvh_scene_free(&s);
+    }
+    /* Huge and tiny coordinates mixed. */
+    cbvh_scene s;
+    random_scene(&s, 300, 1.0f, 0.01f);
+    for (uint32_t i = 0; i < 20; i++)
+        for (int v = 0; v < 3; v++) s.tris[i].v[v][i % 3] *= (i & 1) ? 1e30f : 1e-30f;
+    cbvh_bvh b;
+    no_error(cbvh_build_sah(&s, 0, 2, &b, errbuf, sizeof errbuf));
+    for (int e = 0; e < 2; e++) check_both(&b, 6, -126, (cbvh_encoding)e);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+/* Coordinates up to +-FLT_MAX: decoded bounds reach -2^128 / +Inf. */
+static void test_compress_huge_range(void **st) {
+    (void)st;
+    cbvh_scene s;
+    random_scene(&s, 200, 1.0f, 0.2f);
+    for (uint32_t i = 0; i < s.ntris; i++)
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) s.tris[i].v[v][a] *= 3.4e38f;
+    s.tris[0].v[0][0] = -FLT_MAX;
+    s.tris[1].v[1][1] = FLT_MAX;
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+    uint32_t leaves, inner;
+    cbvh_bvh_counts(&b, &leaves, &inner);
+    assert_true(leaves > 100); /* Morton codes did not collapse */
+    for (int e = 0; e < 2; e++) check_both(&b, 6, -30, (cbvh_encoding)e);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+static void test_compress_single_leaf_root(void **st) {
+    (void)st;
+    cbvh_scene s;
+    random_scene(&s, 3, 1.0f, 0.5f);
+    s.tris[1] = s.tris[2] = s.tris[0];
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    assert_int_equal(b.nnodes, 1);
+    check_both(&b, 6, -30, CBVH_ENC_MODULO);
+    cbvh_tree t;
+    cbvh_compress_opts o = opts(6, -30, CBVH_ENC_MODULO, 1);
+    no_error(cbvh_compress_topdown(&b, &o, &t, errbuf, sizeof errbuf));
+    assert_int_equal(t.npairs, 1);
+    assert_int_equal(t.ids[2], b.prims[2] | CBVH_ID_LAST);
+    assert_int_equal(t.ids[0] & CBVH_ID_LAST, 0);
+    cbvh_tree_free(&t);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+static void test_check_detects_corruption(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    cbvh_compress_opts o = opts(6, -30, CBVH_ENC_MODULO, 1);
+    cbvh_tree t;
+    no_error(cbvh_compress_topdown(&b, &o, &t, errbuf, sizeof errbuf));
+    /* A float box larger than what was compressed is no longer enclosed. */
+    uint32_t c0 = b.nodes[b.root].child[0];
+    float save = b.nodes[c0].hi[0];
+    b.nodes[c0].hi[0] = save + 0.5f * (b.nodes[b.root].hi[0] - save) + 1e-3f;
+    assert_int_equal(cbvh_tree_check(&t, &b, errbuf, sizeof errbuf), -1);
+    assert_non_null(strstr(errbuf, "enclose"));
+    b.nodes[c0].hi[0] = save;
+    no_error(cbvh_tree_check(&t, &b, errbuf, sizeof errbuf));
+    /* A flipped ID flag. */
+    t.ids[0] ^= CBVH_ID_LAST;
+    assert_int_equal(cbvh_tree_check(&t, &b, errbuf, sizeof errbuf), -1);
+    t.ids[0] ^= CBVH_ID_LAST;
+    /* Flipping a root-pair code bit changes or breaks the decoded tree. */
+    int failures = 0;
+    for (int bit = 0; bit < 36; bit++) {
+        t.pairs[(size_t)t.root_pair * t.pair_bytes + (size_t)bit / 8] ^= (uint8_t)(1u << (bit % 8));
+        failures += cbvh_tree_check(&t, &b, errbuf, sizeof errbuf) != 0;
+        t.pairs[(size_t)t.root_pair * t.pair_bytes + (size_t)bit / 8] ^= (uint8_t)(1u << (bit % 8));
+    }
+    assert_true(failures > 0);
+    no_error(cbvh_tree_check(&t, &b, errbuf, sizeof errbuf));
+    /* The CBVH is smaller than the float BVH and its SAH cost is close. */
+    assert_true(cbvh_tree_bytes(&t) < cbvh_bvh_bytes(&b));
+    double q = cbvh_tree_sah(&t) / cbvh_bvh_sah(&b);
+    assert_true(q >= 1.0 && q < 1.5);
+    cbvh_tree_free(&t);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+/* The re-encoding rule behind bit-exactness: for a box quantized at scale a
+ * and re-encoded at b >= a, [u, pred(v)] gives Eq. 1 of the original box,
+ * while [u, v] (as printed) gains one upper cell exactly when v lies on the
+ * 2^b grid. */
+static void test_reencode_rule(void **st) {
+    (void)st;
+    cbvh_params p = {6, -126};
+    int grew = 0;
+    for (int i = 0; i < 200000; i++) {
+        float lo = (rndf() - 0.5f) * 64.0f, hi = lo + rndf() * 8.0f;
+        if (i % 7 == 0) hi = lo; /* flat */
+        cbvh_f32 l, h;
+        memcpy(&l, &lo, 4);
+        memcpy(&h, &hi, 4);
+        int a;
+        assert_int_equal(cbvh_scale_estimate(&p, l, h, &a), 0);
+        int b = a + (int)(rnd() % 12);
+        cbvh_axis_code qa, want, got, naive;
+        assert_int_equal(cbvh_axis_compress(&p, l, h, a, &qa), 0);
+        cbvh_axis_compress(&p, l, h, b, &want);
+        cbvh_axis_compress(&p, qa.clb, cbvh_f32_next_down(qa.cub), b, &got);
+        assert_int_equal(got.lb_mod, want.lb_mod);
+        assert_int_equal(got.ub_mod, want.ub_mod);
+        assert_int_equal(got.clb, want.clb);
+        assert_int_equal(got.cub, want.cub);
+        assert_int_equal(got.child_scale, want.child_scale);
+        cbvh_axis_compress(&p, qa.clb, qa.cub, b, &naive);
+        float v;
+        memcpy(&v, &qa.cub, 4);
+        int on_grid = fmod((double)v, ldexp(1.0, b)) == 0.0;
+        assert_int_equal(naive.ub_mod != want.ub_mod || naive.cub != want.cub, on_grid);
+        grew += on_grid;
+    }
+    assert_true(grew > 1000);
+}
+
+static void test_naive_backtrack_differs(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    cbvh_compress_opts o = opts(6, -30, CBVH_ENC_RELATIVE, 1);
+    cbvh_tree td, nv;
+    cbvh_bu_stats stt;
+    no_error(cbvh_compress_topdown(&b, &o, &td, errbuf, sizeof errbuf));
+    o.naive_reencode = 1;
+    no_error(cbvh_compress_bottomup(&b, NULL, &o, &nv, &stt, errbuf, sizeof errbuf));
+    assert_true(stt.reencodes > 0);
+    no_error(cbvh_tree_check(&nv, &b, errbuf, sizeof errbuf)); /* still encloses */
+    assert_true(cbvh_tree_diff(&td, &nv) >= 0);               /* but not top-down's bits */
+    assert_true(cbvh_tree_sah(&nv) >= cbvh_tree_sah(&td));
+    cbvh_tree_free(&td);
+    cbvh_tree_free(&nv);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+static void test_modulo_fewer_backtracks(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    cbvh_bu_stats rel, mod;
+    cbvh_tree t;
+    cbvh_compress_opts o = opts(6, -30, CBVH_ENC_RELATIVE, 1);
+    no_error(cbvh_compress_bottomup(&b, NULL, &o, &t, &rel, errbuf, sizeof errbuf));
+    cbvh_tree_free(&t);
+    o.enc = CBVH_ENC_MODULO;
+    no_error(cbvh_compress_bottomup(&b, NULL, &o, &t, &mod, errbuf, sizeof errbuf));
+    cbvh_tree_free(&t);
+    assert_true(rel.backtracks > 0);
+    assert_true(mod.backtracks < rel.backtracks);
+    /* Cloth with the finest minimum scale backtracks far more than at 2^-30. */
+    cbvh_scene c;
+    no_error(cbvh_scene_open("proc:cloth:64", &c, errbuf, sizeof errbuf));
+    cbvh_bvh cb;
+    no_error(cbvh_build_lbvh(&c, &cb, errbuf, sizeof errbuf));
+    cbvh_bu_stats fine, coarse;
+    o = opts(6, -126, CBVH_ENC_MODULO, 1);
+    no_error(cbvh_compress_bottomup(&cb, NULL, &o, &t, &fine, errbuf, sizeof errbuf));
+    cbvh_tree_free(&t);
+    o.params.min_scale = -30;
+    no_error(cbvh_compress_bottomup(&cb, NULL, &o, &t, &coarse, errbuf, sizeof errbuf));
+    cbvh_tree_free(&t);
+    assert_true(fine.backtracks > 4 * coarse.backtracks + 10);
+    cbvh_bvh_free(&cb);
+    cbvh_scene_free(&c);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+/* ---- refit ------------------------------------------------------------- */
+
+static void test_refit(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    cbvh_tri *moved = malloc(s.ntris * sizeof *moved);
+    cbvh_scene_deform(&s, 0.8f, 0.05f, 0.3f, moved);
+    cbvh_scene ms = s;
+    ms.tris = moved;
+    /* Refit-then-compress vs streaming refit: same bits, both enclosing. */
+    cbvh_bvh r1 = b, r2 = b;
+    r1.nodes = malloc(b.nnodes * sizeof *b.nodes);
+    r2.nodes = malloc(b.nnodes * sizeof *b.nodes);
+    memcpy(r1.nodes, b.nodes, b.nnodes * sizeof *b.nodes);
+    memcpy(r2.nodes, b.nodes, b.nnodes * sizeof *b.nodes);
+    cbvh_bvh_refit(&r1, moved);
+    no_error(cbvh_bvh_check(&r1, &ms, errbuf, sizeof errbuf));
+    assert_int_equal(cbvh_bvh_check(&b, &ms, errbuf, sizeof errbuf), -1); /* the old boxes no longer fit */
+    for (int e = 0; e < 2; e++) {
+        cbvh_compress_opts o = opts(6, -30, (cbvh_encoding)e, 2);
+        cbvh_tree td, bu;
+        cbvh_bu_stats stt;
+        no_error(cbvh_compress_topdown(&r1, &o, &td, errbuf, sizeof errbuf));
+        no_error(cbvh_compress_bottomup(&r2, moved, &o, &bu, &stt, errbuf, sizeof errbuf));
+        assert_memory_equal(r1.nodes, r2.nodes, b.nnodes * sizeof *b.nodes);
+        no_error(cbvh_tree_check(&bu, &r1, errbuf, sizeof errbuf));
+        assert_int_equal(cbvh_tree_diff(&td, &bu), -1);
+        cbvh_tree_free(&td);
+        cbvh_tree_free(&bu);
+    }
+    free(r1.nodes);
+    free(r2.nodes);
+    free(moved);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_import_bunny),
+        cmocka_unit_test(test_import_formats),
+        cmocka_unit_test(test_import_gltf_morph),
+        cmocka_unit_test(test_import_errors),
+        cmocka_unit_test(test_scene_validate),
+        cmocka_unit_test(test_lbvh_valid),
+        cmocka_unit_test(test_lbvh_equal_codes_share_leaf),
+        cmocka_unit_test(test_sah_valid_and_better),
+        cmocka_unit_test(test_sah_cost_formula),
+        cmocka_unit_test(test_compress_bunny),
+        cmocka_unit_test(test_compress_hard_scenes),
+        cmocka_unit_test(test_compress_huge_range),
+        cmocka_unit_test(test_compress_single_leaf_root),
+        cmocka_unit_test(test_check_detects_corruption),
+        cmocka_unit_test(test_reencode_rule),
+        cmocka_unit_test(test_naive_backtrack_differs),
+        cmocka_unit_test(test_modulo_fewer_backtracks),
+        cmocka_unit_test(test_refit),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
