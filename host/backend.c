@@ -31,7 +31,7 @@ int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, s
             fprintf(log, "cbvh: no board found (usb: %s; hid: %s); using the software model\n", why[0], why[1]);
         return open_one(&cbvh_backend_model, NULL, b, err, errlen) == CBVH_BACKEND_OK ? 0 : -1;
     }
-    const cbvh_backend_ops *all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid};
+    const cbvh_backend_ops *all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid, &cbvh_backend_sim};
     size_t n = strcspn(spec, ":");
     const char *arg = spec[n] == ':' ? spec + n + 1 : NULL;
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
@@ -41,7 +41,7 @@ int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, s
             return rc == CBVH_BACKEND_OK ? 0 : -1;
         }
     }
-    snprintf(err, errlen, "unknown backend '%s' (expected auto, model, usb or hid)", spec);
+    snprintf(err, errlen, "unknown backend '%s' (expected auto, model, usb, hid or sim:ADDR)", spec);
     return -1;
 }
 

@@ -39,8 +39,9 @@ struct cbvh_backend {
 extern const cbvh_backend_ops cbvh_backend_model;
 extern const cbvh_backend_ops cbvh_backend_usb;
 extern const cbvh_backend_ops cbvh_backend_hid;
+extern const cbvh_backend_ops cbvh_backend_sim; /* transport_socket.c: "sim:ADDR", the virtual board */
 
-/* Opens by spec: "auto", "model", "usb", "hid" (later "sim:ADDR").  For auto,
+/* Opens by spec: "auto", "model", "usb", "hid", "sim:ADDR".  For auto,
  * writes one line to log when no board is found.  0 on success. */
 int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen);
 void cbvh_backend_close(cbvh_backend *b);

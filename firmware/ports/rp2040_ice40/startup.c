@@ -1,0 +1,36 @@
+/* Minimal Cortex-M0+ start-up: vector table, .data copy, .bss clear, and the
+ * memset/memcpy the compiler may emit (there is no libc in this image).
+ * A bootable RP2040 image also needs the 256-byte boot2 stage at the start of
+ * flash (pico-sdk, not packaged); the linker script reserves its space. */
+#include <stddef.h>
+#include <stdint.h>
+
+extern uint32_t __data_load, __data_start, __data_end, __bss_start, __bss_end, __stack_top;
+int main(void);
+
+void *memset(void *d, int c, size_t n) {
+    uint8_t *p = d;
+    while (n--) *p++ = (uint8_t)c;
+    return d;
+}
+void *memcpy(void *d, const void *s, size_t n) {
+    uint8_t *p = d;
+    const uint8_t *q = s;
+    while (n--) *p++ = *q++;
+    return d;
+}
+
+void Reset_Handler(void) {
+    for (uint32_t *s = &__data_load, *d = &__data_start; d < &__data_end;) *d++ = *s++;
+    for (uint32_t *d = &__bss_start; d < &__bss_end;) *d++ = 0;
+    main();
+    for (;;) {}
+}
+
+static void Default_Handler(void) {
+    for (;;) {}
+}
+
+__attribute__((section(".vectors"), used)) static void (*const vectors[16])(void) = {
+    (void (*)(void))(uintptr_t)&__stack_top, Reset_Handler, Default_Handler, Default_Handler,
+};

@@ -1,0 +1,48 @@
+/* The sim port: the firmware core on the host.  The USB endpoints are a
+ * socket; the FPGA register map is backed by the bit-exact model (libcbvh). */
+#ifndef CBVH_FW_SIM_H
+#define CBVH_FW_SIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cbvh/unit_table.h"
+#include "cbvh_fw/fw.h"
+#include "cbvh_fw/regmap.h"
+#include "link_fault.h"
+
+/* Model-backed register map (regmap_model.c). */
+typedef struct {
+    uint32_t config, unit_sel, status;
+    uint32_t in[CBVH_REG_WORDS], out[CBVH_REG_WORDS];
+    uint64_t runs;
+    int broken_unit; /* test aid: unit id whose OUT[0] gets bit 0 flipped (a gateware bug), 0 = none */
+} cbvh_regmap_model;
+
+void cbvh_regmap_model_init(cbvh_regmap_model *m);
+uint32_t cbvh_regmap_model_read(void *ctx, uint32_t addr);
+void cbvh_regmap_model_write(void *ctx, uint32_t addr, uint32_t value);
+/* Unit configuration as the datapath decodes the CONFIG register. */
+cbvh_unit_config cbvh_regmap_config(uint32_t config_word);
+
+/* Board addresses: "unix:PATH", "tcp:HOST:PORT", or a bare PATH (contains '/').
+ * Returns a connected/listening fd, or -1 with err set. */
+int cbvh_sim_listen(const char *addr, char *err, size_t errlen);
+int cbvh_sim_connect(const char *addr, char *err, size_t errlen);
+/* Removes a unix socket file created by cbvh_sim_listen. */
+void cbvh_sim_unlink(const char *addr);
+
+typedef struct {
+    int listen_fd;
+    volatile int *stop;       /* serve returns soon after *stop becomes non-zero */
+    int rx_idle_ms;           /* inter-byte timeout of the firmware parser */
+    cbvh_link_fault *faults;  /* faults on the reply direction, or NULL */
+    int verbose;
+    int broken_unit;          /* see cbvh_regmap_model.broken_unit */
+} cbvh_sim_board_opts;
+
+/* Accepts one connection at a time and runs the firmware core on it until
+ * *stop.  Returns 0, or -1 on a listening-socket error. */
+int cbvh_sim_board_serve(const cbvh_sim_board_opts *o);
+
+#endif

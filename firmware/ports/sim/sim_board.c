@@ -1,0 +1,179 @@
+/* The virtual board: the firmware core behind a socket (one connection at a
+ * time), with the model-backed register map as its FPGA. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <netdb.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cbvh_sim.h"
+
+typedef struct {
+    int unix_sock;
+    char path[sizeof(((struct sockaddr_un *)0)->sun_path)];
+    char host[128], port[16];
+} sim_addr;
+
+static int parse_addr(const char *addr, sim_addr *a, char *err, size_t errlen) {
+    memset(a, 0, sizeof *a);
+    const char *path = NULL;
+    if (strncmp(addr, "unix:", 5) == 0) path = addr + 5;
+    else if (strncmp(addr, "tcp:", 4) != 0 && strchr(addr, '/')) path = addr;
+    if (path) {
+        if (!*path || strlen(path) >= sizeof a->path) {
+            snprintf(err, errlen, "bad unix socket path '%s' (empty or longer than %zu bytes)", path,
+                     sizeof a->path - 1);
+            return -1;
+        }
+        a->unix_sock = 1;
+        strcpy(a->path, path);
+        return 0;
+    }
+    const char *hp = strncmp(addr, "tcp:", 4) == 0 ? addr + 4 : addr;
+    const char *colon = strrchr(hp, ':');
+    if (!colon || colon == hp || !colon[1] || (size_t)(colon - hp) >= sizeof a->host || strlen(colon + 1) >= sizeof a->port) {
+        snprintf(err, errlen, "bad board address '%s' (expected unix:PATH or tcp:HOST:PORT)", addr);
+        return -1;
+    }
+    memcpy(a->host, hp, (size_t)(colon - hp));
+    strcpy(a->port, colon + 1);
+    return 0;
+}
+
+static int open_addr(const char *addr, int listening, char *err, size_t errlen) {
+    sim_addr a;
+    if (parse_addr(addr, &a, err, errlen)) return -1;
+    if (a.unix_sock) {
+        int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        if (fd < 0) {
+            snprintf(err, errlen, "socket: %s", strerror(errno));
+            return -1;
+        }
+        struct sockaddr_un sa = {0};
+        sa.sun_family = AF_UNIX;
+        strcpy(sa.sun_path, a.path);
+        int rc = listening ? bind(fd, (struct sockaddr *)&sa, sizeof sa) : connect(fd, (struct sockaddr *)&sa, sizeof sa);
+        if (rc == 0 && listening) rc = listen(fd, 4);
+        if (rc != 0) {
+            snprintf(err, errlen, "%s %s: %s", listening ? "listen on" : "connect to", a.path, strerror(errno));
+            close(fd);
+            return -1;
+        }
+        return fd;
+    }
+    struct addrinfo hints = {0}, *res = NULL;
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    hints.ai_flags = listening ? AI_PASSIVE : 0;
+    int g = getaddrinfo(a.host, a.port, &hints, &res);
+    if (g != 0) {
+        snprintf(err, errlen, "address %s:%s: %s", a.host, a.port, gai_strerror(g));
+        return -1;
+    }
+    int fd = -1;
+    for (struct addrinfo *r = res; r; r = r->ai_next) {
+        fd = socket(r->ai_family, r->ai_socktype | SOCK_CLOEXEC, r->ai_protocol);
+        if (fd < 0) continue;
+        int one = 1;
+        if (listening) setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+        int rc = listening ? bind(fd, r->ai_addr, r->ai_addrlen) : connect(fd, r->ai_addr, r->ai_addrlen);
+        if (rc == 0 && listening) rc = listen(fd, 4);
+        if (rc == 0) break;
+        snprintf(err, errlen, "%s %s:%s: %s", listening ? "listen on" : "connect to", a.host, a.port, strerror(errno));
+        close(fd);
+        fd = -1;
+    }
+    freeaddrinfo(res);
+    return fd;
+}
+
+int cbvh_sim_listen(const char *addr, char *err, size_t errlen) { return open_addr(addr, 1, err, errlen); }
+int cbvh_sim_connect(const char *addr, char *err, size_t errlen) { return open_addr(addr, 0, err, errlen); }
+
+void cbvh_sim_unlink(const char *addr) {
+    sim_addr a;
+    char err[8];
+    if (parse_addr(addr, &a, err, sizeof err) == 0 && a.unix_sock) unlink(a.path);
+}
+
+/* HAL send for the socket: a failed send or injected disconnect marks the
+ * connection as gone; the serve loop then closes it. */
+typedef struct {
+    int fd;
+    int broken;
+    cbvh_link_fault *faults;
+} sim_conn;
+
+typedef struct {
+    cbvh_regmap_model regs;
+    sim_conn conn;
+} sim_board;
+
+static uint32_t hal_read(void *ctx, uint32_t addr) { return cbvh_regmap_model_read(&((sim_board *)ctx)->regs, addr); }
+static void hal_write(void *ctx, uint32_t addr, uint32_t v) { cbvh_regmap_model_write(&((sim_board *)ctx)->regs, addr, v); }
+static void hal_send(void *ctx, const uint8_t *frame, size_t len) {
+    sim_conn *c = &((sim_board *)ctx)->conn;
+    if (c->broken) return;
+    if (cbvh_link_fault_send(c->faults, c->fd, frame, len) != 0) c->broken = 1;
+}
+
+int cbvh_sim_board_serve(const cbvh_sim_board_opts *o) {
+    static const int poll_ms = 10;
+    sim_board *board = calloc(1, sizeof *board);
+    cbvh_fw *fw = calloc(1, sizeof *fw);
+    if (!board || !fw) {
+        free(board);
+        free(fw);
+        return -1;
+    }
+    cbvh_regmap_model_init(&board->regs);
+    board->regs.broken_unit = o->broken_unit;
+    cbvh_fw_hal hal = {board, hal_read, hal_write, hal_send, "cbvh-sim"};
+    cbvh_fw_init(fw, &hal);
+    int rc = 0;
+    while (!*o->stop) {
+        struct pollfd pl = {o->listen_fd, POLLIN, 0};
+        int pr = poll(&pl, 1, poll_ms);
+        if (pr < 0 && errno != EINTR) {
+            rc = -1;
+            break;
+        }
+        if (pr <= 0) continue;
+        int fd = accept4(o->listen_fd, NULL, NULL, SOCK_CLOEXEC);
+        if (fd < 0) continue;
+        board->conn.fd = fd;
+        board->conn.broken = 0;
+        board->conn.faults = o->faults;
+        /* A new connection is a new USB session: stale partial frames go. */
+        cbvh_parser_init(&fw->rx);
+        if (o->verbose) fprintf(stderr, "cbvh board-sim: host connected\n");
+        int idle_ms = 0;
+        while (!*o->stop && !board->conn.broken) {
+            struct pollfd pc = {fd, POLLIN, 0};
+            pr = poll(&pc, 1, poll_ms);
+            if (pr < 0 && errno != EINTR) break;
+            if (pr <= 0) {
+                idle_ms += poll_ms;
+                if (cbvh_fw_rx_partial(fw) && idle_ms >= o->rx_idle_ms) cbvh_fw_rx_idle(fw);
+                continue;
+            }
+            uint8_t buf[8192];
+            ssize_t n = recv(fd, buf, sizeof buf, 0);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) break;
+            idle_ms = 0;
+            cbvh_fw_rx(fw, buf, (size_t)n);
+        }
+        close(fd);
+        if (o->verbose) fprintf(stderr, "cbvh board-sim: host disconnected\n");
+    }
+    free(board);
+    free(fw);
+    return rc;
+}

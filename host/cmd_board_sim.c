@@ -1,0 +1,92 @@
+/* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cbvh_sim.h"
+#include "commands.h"
+
+static volatile int stop_flag;
+static void on_signal(int sig) {
+    (void)sig;
+    stop_flag = 1;
+}
+
+static void usage(FILE *f) {
+    fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--faults SPEC] [--rx-idle-ms N] [--break-unit UNIT] [--verbose]\n"
+               "  Runs the virtual board: the firmware core with the bit-exact model as its FPGA,\n"
+               "  reachable with --backend sim:ADDR.  ADDR: unix:PATH (default unix:/tmp/cbvh-board-UID.sock)\n"
+               "  or tcp:HOST:PORT.  --faults injects faults into the replies, e.g.\n"
+               "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1.\n"
+               "  --break-unit UNIT flips bit 0 of the unit's first output word (a test aid that\n"
+               "  plays a gateware bug: checks against this board must fail).\n"
+               "  Stops on SIGINT/SIGTERM and removes its socket file.\n");
+}
+
+int cmd_board_sim(int argc, char **argv) {
+    char def[128];
+    snprintf(def, sizeof def, "unix:/tmp/cbvh-board-%u.sock", (unsigned)getuid());
+    const char *addr = def, *faults = NULL;
+    int idle = 20, verbose = 0, broken = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(argv[i], "--listen") == 0 && i + 1 < argc) {
+            addr = argv[++i];
+        } else if (strcmp(argv[i], "--faults") == 0 && i + 1 < argc) {
+            faults = argv[++i];
+        } else if (strcmp(argv[i], "--rx-idle-ms") == 0 && i + 1 < argc) {
+            idle = atoi(argv[++i]);
+            if (idle <= 0) {
+                fprintf(stderr, "cbvh board-sim: --rx-idle-ms needs a positive number\n");
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--break-unit") == 0 && i + 1 < argc) {
+            const cbvh_unit *u = cbvh_unit_find(argv[++i]);
+            if (!u) {
+                fprintf(stderr, "cbvh board-sim: --break-unit: unknown unit '%s'\n", argv[i]);
+                return 2;
+            }
+            broken = u->id;
+        } else if (strcmp(argv[i], "--verbose") == 0) {
+            verbose = 1;
+        } else {
+            fprintf(stderr, "cbvh board-sim: unknown or incomplete option '%s'\n", argv[i]);
+            usage(stderr);
+            return 2;
+        }
+    }
+    char err[256];
+    cbvh_link_fault fl;
+    if (faults && cbvh_link_fault_parse(&fl, faults, err, sizeof err)) {
+        fprintf(stderr, "cbvh board-sim: --faults: %s\n", err);
+        return 2;
+    }
+    int fd = cbvh_sim_listen(addr, err, sizeof err);
+    if (fd < 0) {
+        fprintf(stderr, "cbvh board-sim: %s\n", err);
+        return 1;
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    printf("cbvh board-sim: listening on %s\n", addr);
+    fflush(stdout);
+    cbvh_sim_board_opts o = {fd, &stop_flag, idle, faults ? &fl : NULL, verbose, broken};
+    int rc = cbvh_sim_board_serve(&o);
+    close(fd);
+    cbvh_sim_unlink(addr);
+    if (faults) {
+        fprintf(stderr, "cbvh board-sim: reply frames %llu, faults injected:", (unsigned long long)fl.frames);
+        for (int k = 0; k < CBVH_FAULT_KINDS; k++)
+            fprintf(stderr, " %s %llu", cbvh_fault_names[k], (unsigned long long)fl.injected[k]);
+        fprintf(stderr, "\n");
+    }
+    return rc ? 1 : 0;
+}

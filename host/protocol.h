@@ -1,0 +1,88 @@
+/* Host side of the board protocol (docs/protocol.md): requests with sequence
+ * numbers, reply validation, timeouts, retries and resynchronisation, over any
+ * byte link (socket, libusb bulk, hidapi reports). */
+#ifndef CBVH_HOST_PROTOCOL_H
+#define CBVH_HOST_PROTOCOL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cbvh/unit_table.h"
+#include "cbvh_fw/frame.h"
+
+/* One transport's byte I/O. */
+typedef struct {
+    void *ctx;
+    /* Sends a whole frame: 0, or -1 when the link broke (err says why). */
+    int (*write)(void *ctx, const uint8_t *buf, size_t n, char *err, size_t errlen);
+    /* Reads what is there (up to cap), waiting at most timeout_ms: bytes read,
+     * 0 on timeout, -1 when the link broke. */
+    long (*read)(void *ctx, uint8_t *buf, size_t cap, int timeout_ms, char *err, size_t errlen);
+    /* Re-establishes a broken link (NULL: cannot). 0 or -1. */
+    int (*reopen)(void *ctx, char *err, size_t errlen);
+} cbvh_link_io;
+
+typedef struct {
+    uint64_t requests, attempts, replies_ok;
+    uint64_t crc_errors, sync_errors, other_parse_errors; /* detected in replies */
+    uint64_t stale_replies;                               /* wrong sequence number or command */
+    uint64_t timeouts, link_errors_reported;              /* board said our request arrived broken */
+    uint64_t link_breaks, reopens, retries, failures;
+    uint64_t bad_replies; /* CRC fine but fields inconsistent */
+} cbvh_link_stats;
+
+typedef struct {
+    uint8_t proto_version, fw_major, fw_minor, fw_patch;
+    uint32_t datapath_version, units;
+    uint16_t max_payload;
+    uint8_t reg_words;
+    uint32_t reg_id;
+    char board_name[16];
+} cbvh_identity;
+
+typedef struct {
+    cbvh_link_io io;
+    int timeout_ms;  /* per attempt */
+    int max_retries; /* attempts = 1 + max_retries */
+    uint16_t seq;
+    int broken;
+    cbvh_link_stats st;
+    cbvh_parser rx;
+    uint8_t tx[CBVH_FRAME_MAX];
+    uint8_t req[CBVH_FRAME_MAX_PAYLOAD];
+    uint8_t reply[CBVH_FRAME_MAX_PAYLOAD];
+    uint8_t pend[4096]; /* bytes read after an accepted reply, parsed next time */
+    size_t pend_len;
+    cbvh_identity ident;
+} cbvh_link;
+
+#define CBVH_LINK_TIMEOUT_MS_DEFAULT 1000
+#define CBVH_LINK_RETRIES_DEFAULT 8
+
+void cbvh_link_init(cbvh_link *l, const cbvh_link_io *io);
+/* Drops whatever the board still has in flight (after open/reopen). */
+void cbvh_link_flush(cbvh_link *l, int quiet_ms);
+
+/* One request/reply exchange with retries.  On success returns 0 and the
+ * reply payload is in l->reply[0..*reply_len).  Error replies that are not
+ * link errors are final (no retry). */
+int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16_t len, uint16_t *reply_len,
+                       char *err, size_t errlen);
+
+int cbvh_link_identify(cbvh_link *l, char *err, size_t errlen);
+/* Largest number of vectors of this shape in one RUN frame. */
+size_t cbvh_link_max_batch(int n_in, int n_out);
+/* Runs count vectors, split into as many frames as needed.  out is written
+ * only from validated replies; 0 or -1 with err set. */
+int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out,
+                  size_t count, char *err, size_t errlen);
+
+/* Validates a RUN reply payload against the request: 0 or -1 (fuzzed). */
+int cbvh_run_reply_check(const uint8_t *p, size_t len, uint8_t unit, unsigned count, unsigned n_out);
+/* Parses an IDENTIFY reply payload: 0 or -1 (fuzzed). */
+int cbvh_identity_parse(const uint8_t *p, size_t len, cbvh_identity *id);
+
+/* Timeout and retries from CBVH_LINK_TIMEOUT_MS / CBVH_LINK_RETRIES. */
+void cbvh_link_env_options(cbvh_link *l);
+
+#endif
