@@ -4,6 +4,8 @@
 
 #include <string.h>
 
+#include "cbvh/traversal_units.h"
+
 static void add(cbvh_field *f, int *n, const char *name, int digits) {
     f[*n].name = name;
     f[*n].hex_digits = digits;
@@ -195,14 +197,96 @@ static void decode_pair_eval(const cbvh_unit_config *cfg, const uint32_t *in, ui
     *w = st;
 }
 
+/* ---- ray_box (docs/traversal.md §3) ---- */
+static const char *const ray_names[8] = {"ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax"};
+static const char *const grid_names[3][4] = {
+    {"x_u", "x_scale", "x_r", "x_s"}, {"y_u", "y_scale", "y_r", "y_s"}, {"z_u", "z_scale", "z_r", "z_s"}};
+static cbvh_ray ray_words(const uint32_t *in) {
+    cbvh_ray r;
+    for (int a = 0; a < 3; a++) {
+        r.o[a] = in[a];
+        r.d[a] = in[3 + a];
+    }
+    r.tmin = in[6];
+    r.tmax = in[7];
+    return r;
+}
+static void ray_box_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    for (int i = 0; i < 8; i++) add(l->in, &l->n_in, ray_names[i], F32);
+    add(l->in, &l->n_in, "mant", 2);
+    for (int a = 0; a < 3; a++) {
+        add(l->in, &l->n_in, grid_names[a][0], F32);
+        add(l->in, &l->n_in, grid_names[a][1], SCALE);
+        add(l->in, &l->n_in, grid_names[a][2], CODE);
+        add(l->in, &l->n_in, grid_names[a][3], CODE);
+    }
+    add(l->out, &l->n_out, "hit", 1);
+    add(l->out, &l->n_out, "t_near", F32);
+    add(l->out, &l->n_out, "t_far", F32);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void ray_box_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    (void)cfg;
+    cbvh_ray r = ray_words(in);
+    cbvh_grid_axis g[3];
+    for (int a = 0; a < 3; a++) {
+        const uint32_t *w = in + 9 + 4 * a;
+        g[a].u = w[0];
+        g[a].e = cbvh_scale_from_word(w[1]);
+        g[a].r = w[2];
+        g[a].s = w[3];
+    }
+    cbvh_box_result res;
+    uint32_t st = cbvh_ray_box(&r, (int)in[8], g, &res);
+    out[0] = (uint32_t)res.hit;
+    out[1] = res.t_near;
+    out[2] = res.t_far;
+    out[3] = st;
+}
+
+/* ---- ray_triangle (docs/traversal.md §4) ---- */
+static const char *const vert_names[9] = {"v0x", "v0y", "v0z", "v1x", "v1y", "v1z", "v2x", "v2y", "v2z"};
+static void ray_tri_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    for (int i = 0; i < 6; i++) add(l->in, &l->n_in, ray_names[i], F32);
+    for (int i = 0; i < 9; i++) add(l->in, &l->n_in, vert_names[i], F32);
+    add(l->out, &l->n_out, "hit", 1);
+    add(l->out, &l->n_out, "t", F32);
+    add(l->out, &l->n_out, "b1", F32);
+    add(l->out, &l->n_out, "b2", F32);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void ray_tri_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    (void)cfg;
+    cbvh_ray r;
+    for (int a = 0; a < 3; a++) {
+        r.o[a] = in[a];
+        r.d[a] = in[3 + a];
+    }
+    r.tmin = 0;
+    r.tmax = CBVH_F32_POS_INF;
+    cbvh_tri_result res;
+    uint32_t st = cbvh_ray_triangle(&r, in + 6, in + 9, in + 12, &res);
+    out[0] = (uint32_t)res.hit;
+    out[1] = res.t;
+    out[2] = res.b1;
+    out[3] = res.b2;
+    out[4] = st;
+}
+
 static const cbvh_unit unit_estimate = {"scale_estimate", 1, 0, estimate_layout, estimate_eval};
 static const cbvh_unit unit_compress = {"axis_compress", 2, 0, compress_layout, compress_eval};
 static const cbvh_unit unit_decode = {"axis_decode", 3, 1, decode_layout, decode_eval};
 static const cbvh_unit unit_encode_pair = {"nodepair_encode", 4, 1, encode_layout, encode_eval};
 static const cbvh_unit unit_decode_pair = {"nodepair_decode", 5, 1, decode_pair_layout, decode_pair_eval};
+static const cbvh_unit unit_ray_box = {"ray_box", 6, 0, ray_box_layout, ray_box_eval};
+static const cbvh_unit unit_ray_triangle = {"ray_triangle", 7, 0, ray_tri_layout, ray_tri_eval};
 
 const cbvh_unit *const cbvh_units[] = {&unit_estimate, &unit_compress, &unit_decode, &unit_encode_pair,
-                                       &unit_decode_pair};
+                                       &unit_decode_pair, &unit_ray_box, &unit_ray_triangle};
 const int cbvh_unit_count = (int)(sizeof cbvh_units / sizeof cbvh_units[0]);
 
 const cbvh_unit *cbvh_unit_find(const char *name) {

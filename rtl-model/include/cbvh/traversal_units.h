@@ -1,0 +1,69 @@
+/* The accelerator's traversal units, bit-exact and integer-defined.
+ *
+ * Spec: docs/traversal.md.  One unit per source file:
+ *   ray_box.c        low-precision ray-box test on the decoded grid (Eq. 4/5)
+ *   ray_triangle.c   watertight ray-triangle test (Woop, Benthin, Wald 2013)
+ * Ports are binary32 bit patterns (cbvh_f32); status bits are those of
+ * datapath.h plus CBVH_ST_ZERO_DIR below. */
+#ifndef CBVH_TRAVERSAL_UNITS_H
+#define CBVH_TRAVERSAL_UNITS_H
+
+#include <stdint.h>
+
+#include "cbvh/datapath.h"
+
+#define CBVH_MANT_MIN 3   /* M: mantissa bits of the box unit's plane distances */
+#define CBVH_MANT_MAX 24
+#define CBVH_CODE_MAX 1024 /* r, s of the box unit: 0 .. 2^10 (s = 2^N allowed) */
+
+/* Reject: the ray direction is the zero vector (status bit 7). */
+#define CBVH_ST_ZERO_DIR (1u << 7)
+
+/* A ray o + t d, t in [tmin, tmax].  All finite except tmax, which may be
+ * +Inf (an unbounded ray). */
+typedef struct {
+    cbvh_f32 o[3], d[3];
+    cbvh_f32 tmin, tmax;
+} cbvh_ray;
+
+/* One axis of a box as two exact planes on the decoded grid:
+ *   lower plane u + r * 2^e,  upper plane u + s * 2^e,  0 <= r < s <= 1024,
+ * u a binary32 pattern (-Inf encodes -2^128, as in a context), e in
+ * [-126, 126].  A float box axis [lo, hi] is {u = lo, e = 0, r = 0, s = 0}
+ * with upper plane hi: see cbvh_ray_box_float. */
+typedef struct {
+    cbvh_f32 u;
+    int e;
+    uint32_t r, s;
+} cbvh_grid_axis;
+
+typedef struct {
+    int hit;
+    cbvh_f32 t_near, t_far; /* RD/RU to M bits, clamped to [tmin, tmax]; +0 on a miss */
+} cbvh_box_result;
+
+/* Ray-box unit (docs/traversal.md §3).  mant_bits = M in [3, 24]. */
+uint32_t cbvh_ray_box(const cbvh_ray *ray, int mant_bits, const cbvh_grid_axis axis[3], cbvh_box_result *out);
+
+/* The same datapath with the planes given as float bounds lo[a] <= hi[a]
+ * (used by the float-BVH reference traversal). */
+uint32_t cbvh_ray_box_float(const cbvh_ray *ray, int mant_bits, const cbvh_f32 lo[3], const cbvh_f32 hi[3],
+                            cbvh_box_result *out);
+
+typedef struct {
+    int hit;
+    cbvh_f32 t;      /* RD(t), t > 0 */
+    cbvh_f32 b1, b2; /* RD of the barycentrics of v1 and v2 */
+} cbvh_tri_result;
+
+/* Watertight ray-triangle unit (docs/traversal.md §4).  The ray's tmin/tmax
+ * are not used: the unit reports every hit with t > 0. */
+uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                           cbvh_tri_result *out);
+
+/* Total order key of a binary32 value incl. +-Inf (+0 == -0); NaN not allowed. */
+static inline int64_t cbvh_f32_key(cbvh_f32 x) {
+    return (x & CBVH_F32_SIGN) ? -(int64_t)(x & ~CBVH_F32_SIGN) : (int64_t)x;
+}
+
+#endif

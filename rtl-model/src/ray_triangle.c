@@ -1,0 +1,97 @@
+/* Unit 7: watertight ray-triangle test (Woop, Benthin, Wald 2013), integer-
+ * defined (docs/traversal.md §4).
+ *
+ * The paper translates the vertices to the ray origin, permutes the axes so
+ * that z is the largest direction component, shears the ray onto +z and
+ * evaluates the three 2D edge functions; when an edge function is exactly 0
+ * in single precision it recomputes it in double precision.  This model
+ * evaluates every quantity exactly (scaled by powers of d_z so no division is
+ * needed), which is what the fallback approximates: the edge functions' signs
+ * are exact, so a ray through a shared edge or vertex of a closed mesh always
+ * hits at least one of the adjacent triangles.  Integer-only. */
+#include <string.h>
+
+#include "cbvh/traversal_units.h"
+#include "exact_wide.h"
+
+uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                           cbvh_tri_result *out) {
+    memset(out, 0, sizeof *out);
+    int bad = 0;
+    for (int a = 0; a < 3; a++)
+        bad |= cbvh_f32_is_nan_or_inf(ray->o[a]) | cbvh_f32_is_nan_or_inf(ray->d[a]) |
+               cbvh_f32_is_nan_or_inf(v0[a]) | cbvh_f32_is_nan_or_inf(v1[a]) | cbvh_f32_is_nan_or_inf(v2[a]);
+    if (bad) return CBVH_ST_NAN_INF;
+    if (cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]))
+        return CBVH_ST_ZERO_DIR;
+
+    /* Axis permutation: kz = largest |d| (first on ties), kx, ky follow
+     * cyclically and swap when d_kz < 0 (keeps the winding, as in the paper). */
+    int kz = 0;
+    for (int a = 1; a < 3; a++)
+        if ((ray->d[a] & ~CBVH_F32_SIGN) > (ray->d[kz] & ~CBVH_F32_SIGN)) kz = a;
+    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+    if (ray->d[kz] & CBVH_F32_SIGN) {
+        int t = kx;
+        kx = ky;
+        ky = t;
+    }
+    cbvh_xw dx, dy, dz;
+    cbvh_xw_from_f32(&dx, ray->d[kx]);
+    cbvh_xw_from_f32(&dy, ray->d[ky]);
+    cbvh_xw_from_f32(&dz, ray->d[kz]);
+
+    /* Translated vertices P = v - o; sheared, scaled by d_z:
+     *   X = P_x d_z - P_z d_x = d_z * (paper's A_x),  Y likewise,
+     *   Z = P_z                = d_z * (paper's A_z). */
+    const cbvh_f32 *v[3] = {v0, v1, v2};
+    cbvh_xw X[3], Y[3], Z[3];
+    for (int i = 0; i < 3; i++) {
+        cbvh_xw o, p, px, py, t1, t2;
+        cbvh_xw_from_f32(&o, ray->o[kx]);
+        cbvh_xw_from_f32(&p, v[i][kx]);
+        cbvh_xw_sub(&px, &p, &o);
+        cbvh_xw_from_f32(&o, ray->o[ky]);
+        cbvh_xw_from_f32(&p, v[i][ky]);
+        cbvh_xw_sub(&py, &p, &o);
+        cbvh_xw_from_f32(&o, ray->o[kz]);
+        cbvh_xw_from_f32(&p, v[i][kz]);
+        cbvh_xw_sub(&Z[i], &p, &o);
+        cbvh_xw_mul(&t1, &px, &dz);
+        cbvh_xw_mul(&t2, &Z[i], &dx);
+        cbvh_xw_sub(&X[i], &t1, &t2);
+        cbvh_xw_mul(&t1, &py, &dz);
+        cbvh_xw_mul(&t2, &Z[i], &dy);
+        cbvh_xw_sub(&Y[i], &t1, &t2);
+    }
+    /* Edge functions (d_z^2 times the paper's U, V, W; same signs):
+     *   U = X2 Y1 - Y2 X1,  V = X0 Y2 - Y0 X2,  W = X1 Y0 - Y1 X0. */
+    cbvh_xw E[3];
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3; /* E[0] = U: opposite v0 */
+        cbvh_xw t1, t2;
+        cbvh_xw_mul(&t1, &X[k], &Y[j]);
+        cbvh_xw_mul(&t2, &Y[k], &X[j]);
+        cbvh_xw_sub(&E[i], &t1, &t2);
+    }
+    int s0 = cbvh_xw_sign(&E[0]), s1 = cbvh_xw_sign(&E[1]), s2 = cbvh_xw_sign(&E[2]);
+    if ((s0 < 0 || s1 < 0 || s2 < 0) && (s0 > 0 || s1 > 0 || s2 > 0)) return 0; /* outside an edge */
+    cbvh_xw det, T, t1;
+    cbvh_xw_add(&det, &E[0], &E[1]);
+    cbvh_xw_add(&det, &det, &E[2]);
+    if (det.n == 0) return 0; /* ray in the triangle's plane, or degenerate triangle */
+    /* T = U Z0 + V Z1 + W Z2 = d_z^3 * (paper's T);  t = T / (d_z det). */
+    cbvh_xw_mul(&T, &E[0], &Z[0]);
+    cbvh_xw_mul(&t1, &E[1], &Z[1]);
+    cbvh_xw_add(&T, &T, &t1);
+    cbvh_xw_mul(&t1, &E[2], &Z[2]);
+    cbvh_xw_add(&T, &T, &t1);
+    cbvh_xw den;
+    cbvh_xw_mul(&den, &det, &dz);
+    if (cbvh_xw_sign(&T) * cbvh_xw_sign(&den) <= 0) return 0; /* behind the origin or at t = 0 */
+    out->hit = 1;
+    out->t = cbvh_xw_div_round(&T, &den, 24, CBVH_RND_DOWN);
+    out->b1 = cbvh_xw_div_round(&E[1], &det, 24, CBVH_RND_DOWN);
+    out->b2 = cbvh_xw_div_round(&E[2], &det, 24, CBVH_RND_DOWN);
+    return 0;
+}

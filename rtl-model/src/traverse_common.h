@@ -1,0 +1,78 @@
+/* Shared pieces of the two traversals (docs/traversal.md §5). */
+#ifndef CBVH_TRAVERSE_COMMON_H
+#define CBVH_TRAVERSE_COMMON_H
+
+#include <string.h>
+
+#include "cbvh/traverse.h"
+
+/* Memory image used for the byte counters: node pairs from address 0, then
+ * the primitive-ID array, then the triangles (36 bytes each), each region
+ * starting on a line. */
+typedef struct {
+    const cbvh_ray *ray;
+    const cbvh_tri *tris;
+    cbvh_trav_mode mode;
+    int M;
+    uint64_t ids_base, tris_base;
+    cbvh_trav_hit best;
+    cbvh_trav_stats s;
+    int done; /* any-hit found */
+} trav_state;
+
+static inline uint64_t trav_align(uint64_t a) { return (a + CBVH_LINE_BYTES - 1) / CBVH_LINE_BYTES * CBVH_LINE_BYTES; }
+
+static inline void trav_fetch(trav_state *ts, uint64_t addr, uint64_t size) {
+    uint64_t n = cbvh_lines_touched(addr, size);
+    ts->s.lines += n;
+    ts->s.bytes += n * CBVH_LINE_BYTES;
+}
+
+/* Upper t for box culling: a triangle is accepted when RD(t) <= X (X = ray
+ * tmax, or the best t so far), i.e. t < next_up(X); boxes are kept up to
+ * next_up(X) inclusive so no acceptable triangle is ever culled. */
+static inline cbvh_f32 trav_box_tmax(const trav_state *ts) {
+    cbvh_f32 x = ts->ray->tmax;
+    if (ts->best.hit && cbvh_f32_key(ts->best.t) < cbvh_f32_key(x)) x = ts->best.t;
+    return x == CBVH_F32_POS_INF ? x : cbvh_f32_next_up(x);
+}
+
+static inline void trav_triangle(trav_state *ts, uint32_t id) {
+    cbvh_f32 v[3][3];
+    memcpy(v, ts->tris[id].v, sizeof v);
+    trav_fetch(ts, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
+    ts->s.tri_tests++;
+    cbvh_tri_result r;
+    if (cbvh_ray_triangle(ts->ray, v[0], v[1], v[2], &r) || !r.hit) return;
+    int64_t k = cbvh_f32_key(r.t);
+    if (k < cbvh_f32_key(ts->ray->tmin) || k > cbvh_f32_key(ts->ray->tmax)) return;
+    if (ts->best.hit) {
+        int64_t kb = cbvh_f32_key(ts->best.t);
+        if (k > kb || (k == kb && id >= ts->best.prim)) return;
+    }
+    ts->best.hit = 1;
+    ts->best.prim = id;
+    ts->best.t = r.t;
+    ts->best.b1 = r.b1;
+    ts->best.b2 = r.b2;
+    if (ts->mode == CBVH_TRAV_ANY) ts->done = 1;
+}
+
+/* A ray the units reject (NaN/Inf, zero direction) is an error for the traversal. */
+static inline int trav_ray_ok(const cbvh_ray *ray, int M) {
+    cbvh_f32 lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    cbvh_box_result r;
+    return cbvh_ray_box_float(ray, M, lo, hi, &r) == 0;
+}
+
+static inline void trav_finish(const trav_state *ts, cbvh_trav_hit *hit, cbvh_trav_stats *st) {
+    *hit = ts->best;
+    st->nodes += ts->s.nodes;
+    st->box_tests += ts->s.box_tests;
+    st->tri_tests += ts->s.tri_tests;
+    st->lines += ts->s.lines;
+    st->bytes += ts->s.bytes;
+    if (ts->s.max_stack > st->max_stack) st->max_stack = ts->s.max_stack;
+}
+
+#endif
