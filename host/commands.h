@@ -7,4 +7,8 @@
 int cmd_vectors(int argc, char **argv); /* cmd_vectors.c: gen | check */
 int cmd_run(int argc, char **argv);     /* cmd_run.c: the main job */
 
+int cmd_devices(int argc, char **argv);   /* cmd_devices.c: boards per backend */
+int cmd_board_sim(int argc, char **argv); /* cmd_board_sim.c: the virtual board */
+int cmd_study(int argc, char **argv);     /* cmd_study.c: backtracking/memory-traffic study (issue 3) */
+
 #endif

@@ -13,6 +13,9 @@ typedef struct {
 static const command commands[] = {
     {"run", cmd_run, "the main job: check the golden vectors, then an accuracy-vs-time table"},
     {"vectors", cmd_vectors, "generate (gen) or check (check) golden test vectors"},
+    {"devices", cmd_devices, "list boards per backend (usb, hid, sim) and why none"},
+    {"board-sim", cmd_board_sim, "run the virtual board (firmware sim port) on a socket"},
+    {"study", cmd_study, "backtracking, memory-traffic and min-scale study of streaming CBVH builds"},
 };
 
 static void usage(FILE *f) {
