@@ -69,7 +69,7 @@ static inline void merge_box(cbvh_bvh_node *p, const cbvh_bvh_node *a, const cbv
     }
 }
 
-/* Centre of a triangle's box along axis a, without overflow up to FLT_MAX. */
+/* Centre of a triangle's box, without overflow for coordinates up to FLT_MAX. */
 static inline void tri_centre(const cbvh_tri *t, float c[3]) {
     float lo[3], hi[3];
     cbvh_tri_bounds(t, lo, hi);
@@ -163,7 +163,7 @@ int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen
     uint32_t nn = 2 * m - 1, L = m - 1; /* L: first leaf node index */
     cbvh_bvh_node *nodes = malloc((size_t)nn * sizeof *nodes);
     if (!nodes) abort();
-    cbvh_bvh_node *lf = &nodes[L] - 1;
+    cbvh_bvh_node *lf = NULL; /* the current leaf */
     for (uint32_t i = 0, c = 0; i < n; i++) {
         uint32_t code = (uint32_t)(keys[i] >> 32), t = (uint32_t)keys[i];
         float lo[3], hi[3];
@@ -171,7 +171,7 @@ int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen
         prims[i] = t;
         if (i == 0 || code != c) {
             c = code;
-            lf++;
+            lf = lf ? lf + 1 : &nodes[L];
             lf->child[0] = lf->child[1] = 0;
             lf->first = i;
             lf->count = 1;

@@ -102,9 +102,14 @@ uint32_t cbvh_scale_estimate(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int
     if (vl >= vu) return estimate_general(p, lb, ub, scale); /* inverted or a point */
     int e0 = cbvh_grid_bitlen((uint64_t)(vu - vl)) + xlo - n;
     if (e0 < ms) e0 = ms;
-    int d = e0 - xlo, fit = 1, inexact;
-    if (d > 0)
-        fit = cbvh_grid_floor_shift(vu, d, &inexact) + 1 - cbvh_grid_floor_shift(vl, d, &inexact) <= (INT64_C(1) << n);
+    /* cells(e0) = floor(vu / 2^d) + 1 - floor(vl / 2^d), d = e0 - xlo.  With
+     * |v| < 2^62, floor(v / 2^d) = ((v + 2^62) >> d) - 2^(62 - d) for
+     * d <= 62 (the offsets cancel in the difference), and every d >= 62 gives
+     * the same floors (-1 or 0).  d <= 0: always fits (see above). */
+    int d = e0 - xlo;
+    if (d > 62) d = 62;
+    uint64_t ou = (uint64_t)(vu + (INT64_C(1) << 62)), ol = (uint64_t)(vl + (INT64_C(1) << 62));
+    int fit = d <= 0 || (ou >> d) - (ol >> d) + 1u <= (UINT64_C(1) << n);
     *scale = fit ? e0 : e0 + 1;
     return 0;
 }
