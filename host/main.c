@@ -16,6 +16,7 @@ static const command commands[] = {
     {"devices", cmd_devices, "list boards per backend (usb, hid, sim) and why none"},
     {"board-sim", cmd_board_sim, "run the virtual board (firmware sim port) on a socket"},
     {"study", cmd_study, "backtracking, memory-traffic and min-scale study of streaming CBVH builds"},
+    {"trace", cmd_trace, "trace the rays a scene file's effects call for; cost per effect and timing model"},
 };
 
 static void usage(FILE *f) {

@@ -1,0 +1,334 @@
+/* cbvh trace SCENE: trace only the rays a scene's effects call for, on the
+ * float BVH and/or the CBVH, and report the cost per effect with the timing
+ * model (docs/scenes.md, docs/timing_model.md). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "effects.h"
+#include "scene_file.h"
+#include "timing_model.h"
+
+static void usage(FILE *f) {
+    fprintf(f,
+            "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format float|cbvh] [--json]\n"
+            "                        [--spp K]\n"
+            "  Traces the rays the scene file's effects call for (docs/scenes.md) and prints, per effect:\n"
+            "  rays, box/triangle tests, nodes and bytes per ray, deepest stack, modelled time per ray\n"
+            "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default) also\n"
+            "  each relative to the float BVH on the same rays, and a units-active line.\n"
+            "  --bits N       CBVH coordinate bits, %d..%d (default 6)\n"
+            "  --mant M       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
+            "  --min-scale E  minimum grid scale, -126..126 (default %d)\n"
+            "  --format F     float: the float BVH only; cbvh: the CBVH against the float BVH (default)\n"
+            "  --spp K        camera samples per pixel, 1..1024 (default: the scene's camera.spp)\n"
+            "  --json         machine-readable output\n",
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
+}
+
+static int parse_int(const char *opt, const char *s, long lo, long hi, int *out) {
+    char *end;
+    long v = s ? strtol(s, &end, 10) : 0;
+    if (!s || !*s || *end || v < lo || v > hi) {
+        fprintf(stderr, "cbvh trace: %s expects an integer in %ld..%ld, got '%s'\n", opt, lo, hi, s ? s : "");
+        return -1;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+typedef struct {
+    const char *label;
+    int last_row;
+} progress_ctx;
+
+static void progress(void *ctx, int frame, int frames, int row, int rows) {
+    progress_ctx *p = ctx;
+    if (row % 4 && row != rows - 1) return;
+    fprintf(stderr, "\rtrace %s: frame %d/%d, row %d/%d   ", p->label, frame + 1, frames, row + 1, rows);
+    p->last_row = 1;
+}
+
+typedef struct {
+    double rays, box, tri, nodes, bytes, model_ns, cpu_us;
+    uint32_t stack;
+} per_ray;
+
+static per_ray summarize(const cbvh_fx_stats *s, const cbvh_timing_params *tp) {
+    per_ray p = {0};
+    p.rays = (double)s->rays;
+    p.stack = s->st.max_stack;
+    if (!s->rays) return p;
+    double n = (double)s->rays;
+    p.box = (double)s->st.box_tests / n;
+    p.tri = (double)s->st.tri_tests / n;
+    p.nodes = (double)s->st.nodes / n;
+    p.bytes = (double)s->st.bytes / n;
+    cbvh_timing_work w = {s->st.box_tests, s->st.tri_tests, s->st.nodes, s->st.bytes};
+    cbvh_timing_result tr;
+    if (cbvh_timing_eval(tp, &w, &tr) == 0) p.model_ns = tr.seconds * 1e9 / n;
+    p.cpu_us = s->cpu_seconds * 1e6 / n;
+    return p;
+}
+
+static cbvh_fx_stats total_stats(const cbvh_fx_result *r) {
+    cbvh_fx_stats t = {0};
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        const cbvh_fx_stats *s = &r->fx[e];
+        t.rays += s->rays;
+        t.closest += s->closest;
+        t.any += s->any;
+        t.hits += s->hits;
+        t.rejected += s->rejected;
+        t.st.nodes += s->st.nodes;
+        t.st.box_tests += s->st.box_tests;
+        t.st.tri_tests += s->st.tri_tests;
+        t.st.lines += s->st.lines;
+        t.st.bytes += s->st.bytes;
+        if (s->st.max_stack > t.st.max_stack) t.st.max_stack = s->st.max_stack;
+        t.cpu_seconds += s->cpu_seconds;
+    }
+    return t;
+}
+
+/* A JSON string literal (paths may hold quotes, backslashes, control bytes). */
+static void json_str(const char *s) {
+    putchar('"');
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            printf("\\%c", c);
+        else if (c < 0x20)
+            printf("\\u%04x", c);
+        else
+            putchar(c);
+    }
+    putchar('"');
+}
+
+static double ratio(double a, double b) { return b > 0 ? a / b : 0; }
+
+
+static void print_row(const char *name, const char *kind, const per_ray *p, const per_ray *f) {
+    printf("%-18s %-7s %9.0f %8.2f %7.2f %8.1f %8.0f %5u %9.1f %8.2f", name, kind, p->rays, p->box, p->tri, p->nodes,
+           p->bytes, p->stack, p->model_ns, p->cpu_us);
+    if (f) {
+        double a[5] = {p->box, p->tri, p->bytes, p->model_ns, p->cpu_us}, b[5] = {f->box, f->tri, f->bytes,
+                                                                                    f->model_ns, f->cpu_us};
+        printf("  ");
+        for (int i = 0; i < 5; i++) {
+            if (b[i] > 0)
+                printf(" x%.3f", a[i] / b[i]);
+            else
+                printf(" %6s", a[i] > 0 ? "x inf" : "-"); /* the float BVH did none */
+        }
+    }
+    printf("\n");
+}
+
+static void json_stats(const char *key, const cbvh_fx_stats *s, const cbvh_timing_params *tp, int comma) {
+    per_ray p = summarize(s, tp);
+    printf("%s\"%s\":{\"rays\":%llu,\"closest_hit\":%llu,\"any_hit\":%llu,\"hits\":%llu,\"rejected\":%llu,"
+           "\"nodes\":%llu,\"box_tests\":%llu,\"tri_tests\":%llu,\"bytes\":%llu,\"max_stack\":%u,"
+           "\"box_per_ray\":%.6g,\"tri_per_ray\":%.6g,\"bytes_per_ray\":%.6g,\"model_ns_per_ray\":%.6g,"
+           "\"cpu_us_per_ray\":%.6g}",
+           comma ? "," : "", key, (unsigned long long)s->rays, (unsigned long long)s->closest,
+           (unsigned long long)s->any, (unsigned long long)s->hits, (unsigned long long)s->rejected,
+           (unsigned long long)s->st.nodes, (unsigned long long)s->st.box_tests, (unsigned long long)s->st.tri_tests,
+           (unsigned long long)s->st.bytes, s->st.max_stack, p.box, p.tri, p.bytes, p.model_ns, p.cpu_us);
+}
+
+static void json_result(const char *key, const cbvh_scene_desc *d, const cbvh_fx_result *r,
+                        const cbvh_timing_params *tp) {
+    printf(",\"%s\":{\"node_bytes\":%llu,\"build_cpu_s\":%.6g,\"refits\":%llu,\"effects\":{", key,
+           (unsigned long long)r->node_bytes, r->build_cpu_seconds, (unsigned long long)r->refits);
+    int first = 1;
+    for (int e = 0; e < CBVH_FX_COUNT; e++)
+        if (d->effect[e].enabled) {
+            json_stats(cbvh_effect_name((cbvh_effect)e), &r->fx[e], tp, !first);
+            first = 0;
+        }
+    cbvh_fx_stats t = total_stats(r);
+    printf("},");
+    json_stats("total", &t, tp, 0);
+    printf(",\"units\":{\"compressor\":%llu,\"decoder\":%llu,\"ray_box\":%llu,\"ray_triangle\":%llu,\"refit\":%llu}"
+           ",\"hit_digest\":\"%016llx\"}",
+           (unsigned long long)r->units.compressor, (unsigned long long)r->units.decoder,
+           (unsigned long long)r->units.ray_box, (unsigned long long)r->units.ray_triangle,
+           (unsigned long long)r->units.refit, (unsigned long long)r->hit_digest);
+}
+
+static void print_units(const cbvh_unit_activity *u, int animated) {
+    const char *names[] = {"compressor", "decoder", "ray_box", "ray_triangle", "refit"};
+    uint64_t v[] = {u->compressor, u->decoder, u->ray_box, u->ray_triangle, u->refit};
+    printf("units active:");
+    int any = 0;
+    for (int i = 0; i < 5; i++)
+        if (v[i]) printf("%s %s %llu", any++ ? "," : "", names[i], (unsigned long long)v[i]);
+    printf("  | idle:");
+    any = 0;
+    for (int i = 0; i < 5; i++)
+        if (!v[i]) printf("%s %s", any++ ? "," : "", names[i]);
+    if (!any) printf(" none");
+    printf("%s\n", animated ? "" : "  (static scene: no refit)");
+}
+
+int cmd_trace(int argc, char **argv) {
+    const char *scene = NULL;
+    int bits = 6, mant = 24, min_scale = CBVH_MIN_SCALE_DEFAULT, spp = 0, json = 0;
+    cbvh_accel_format fmt = CBVH_FORMAT_CBVH;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--json") == 0)
+            json = 1;
+        else if (strcmp(a, "--bits") == 0) {
+            if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, CBVH_N_MIN, CBVH_N_MAX, &bits)) return 2;
+        } else if (strcmp(a, "--mant") == 0) {
+            if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, CBVH_MANT_MIN, CBVH_MANT_MAX, &mant)) return 2;
+        } else if (strcmp(a, "--min-scale") == 0) {
+            if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, -126, 126, &min_scale)) return 2;
+        } else if (strcmp(a, "--spp") == 0) {
+            if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, 1, 1024, &spp)) return 2;
+        } else if (strcmp(a, "--format") == 0) {
+            const char *f = i + 1 < argc ? argv[++i] : "";
+            if (strcmp(f, "float") == 0)
+                fmt = CBVH_FORMAT_FLOAT;
+            else if (strcmp(f, "cbvh") == 0)
+                fmt = CBVH_FORMAT_CBVH;
+            else {
+                fprintf(stderr, "cbvh trace: --format expects float or cbvh, got '%s'\n", f);
+                return 2;
+            }
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "cbvh trace: unknown option '%s' (see cbvh trace --help)\n", a);
+            return 2;
+        } else if (scene) {
+            fprintf(stderr, "cbvh trace: more than one scene ('%s', '%s')\n", scene, a);
+            return 2;
+        } else
+            scene = a;
+    }
+    if (!scene) {
+        fprintf(stderr, "cbvh trace: no scene file given (see cbvh trace --help)\n");
+        return 2;
+    }
+    cbvh_scene_desc d;
+    char err[1024];
+    if (cbvh_scene_file_load(scene, &d, err, sizeof err)) {
+        fprintf(stderr, "cbvh trace: %s\n", err);
+        return 2;
+    }
+    cbvh_timing_params tp;
+    cbvh_timing_defaults(&tp);
+    {
+        const cbvh_timing_overrides *o = &d.timing;
+        if (o->box_cycles == o->box_cycles) tp.box_cycles = o->box_cycles; /* not NaN: set in the scene */
+        if (o->tri_cycles == o->tri_cycles) tp.tri_cycles = o->tri_cycles;
+        if (o->fetch_latency == o->fetch_latency) tp.fetch_latency = o->fetch_latency;
+        if (o->dram_bytes_per_cycle == o->dram_bytes_per_cycle) tp.dram_bytes_per_cycle = o->dram_bytes_per_cycle;
+        if (o->clock_mhz == o->clock_mhz) tp.clock_mhz = o->clock_mhz;
+    }
+    progress_ctx pc = {"float", 0};
+    int tty = isatty(2) && !json;
+    cbvh_fx_opts fo = {CBVH_FORMAT_FLOAT, {bits, min_scale}, fmt == CBVH_FORMAT_FLOAT ? mant : 24, spp, NULL,
+                       tty ? progress : NULL, &pc};
+    static cbvh_fx_result rf, rc;
+    int status = 0;
+    if (cbvh_fx_run(&d, &fo, &rf, err, sizeof err)) {
+        if (pc.last_row) fprintf(stderr, "\n");
+        fprintf(stderr, "cbvh trace: %s: %s\n", scene, err);
+        cbvh_scene_desc_free(&d);
+        return 1;
+    }
+    const cbvh_fx_result *main_r = &rf;
+    if (fmt == CBVH_FORMAT_CBVH) {
+        pc.label = "cbvh";
+        fo.format = CBVH_FORMAT_CBVH;
+        fo.mant = mant;
+        if (cbvh_fx_run(&d, &fo, &rc, err, sizeof err)) {
+            if (pc.last_row) fprintf(stderr, "\n");
+            fprintf(stderr, "cbvh trace: %s: %s\n", scene, err);
+            cbvh_scene_desc_free(&d);
+            return 1;
+        }
+        main_r = &rc;
+        if (rc.hit_digest != rf.hit_digest) status = 1; /* CBVH must return the float BVH's hits */
+    }
+    if (pc.last_row) fprintf(stderr, "\r%60s\r", "");
+    int spp_used = spp ? spp : d.camera.spp;
+    static const char *cams[] = {"pinhole", "thin_lens", "fisheye"};
+    if (json) {
+        printf("{\"scene\":");
+        json_str(scene);
+        printf(",\"mesh\":");
+        json_str(d.mesh_spec);
+        printf(",\"triangles\":%u,\"frames\":%d,\"camera\":\"%s\",\"width\":%d,"
+               "\"height\":%d,\"spp\":%d,\"format\":\"%s\",\"bits\":%d,\"mant\":%d,\"min_scale\":%d,"
+               "\"timing\":{\"box_cycles\":%g,\"tri_cycles\":%g,\"fetch_latency\":%g,\"dram_bytes_per_cycle\":%g,"
+               "\"clock_mhz\":%g}",
+               d.mesh.ntris, rf.frames, cams[d.camera.type], d.camera.width, d.camera.height,
+               spp_used, fmt == CBVH_FORMAT_CBVH ? "cbvh" : "float", bits, mant, min_scale, tp.box_cycles,
+               tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
+        json_result("float", &d, &rf, &tp);
+        if (fmt == CBVH_FORMAT_CBVH) {
+            json_result("cbvh", &d, &rc, &tp);
+            printf(",\"same_hits\":%s", status ? "false" : "true");
+        }
+        printf("}\n");
+    } else {
+        printf("scene %s: %s, %u triangles, %d frame%s%s, %s camera %dx%d, %d spp\n", scene, d.mesh_spec, d.mesh.ntris,
+               rf.frames, rf.frames > 1 ? "s" : "", rf.frames > 1 ? " (animated: refit per frame)" : " (static)",
+               cams[d.camera.type], d.camera.width, d.camera.height, spp_used);
+        if (fmt == CBVH_FORMAT_CBVH)
+            printf("format cbvh: N=%d, M=%d, min scale %d, modulo; node memory %llu B (float BVH %llu B, x%.3f)\n", bits,
+                   mant, min_scale, (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
+                   ratio((double)rc.node_bytes, (double)rf.node_bytes));
+        else
+            printf("format float: M=%d; node memory %llu B\n", mant, (unsigned long long)rf.node_bytes);
+        printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
+               "(docs/timing_model.md)\n\n",
+               tp.box_cycles, tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
+        printf("%-18s %-7s %9s %8s %7s %8s %8s %5s %9s %8s", "effect", "kind", "rays", "box/ray", "tri/ray",
+               "node/ray", "B/ray", "stack", "model ns", "CPU us");
+        if (fmt == CBVH_FORMAT_CBVH) printf("   vs float: box, tri, bytes, model, CPU");
+        printf("\n");
+        per_ray pf[CBVH_FX_COUNT + 1], pm;
+        for (int e = 0; e < CBVH_FX_COUNT; e++) {
+            if (!d.effect[e].enabled) continue;
+            pf[e] = summarize(&rf.fx[e], &tp);
+            pm = summarize(&main_r->fx[e], &tp);
+            const char *kind = main_r->fx[e].any ? (main_r->fx[e].closest ? "mixed" : "any") : "closest";
+            if (!main_r->fx[e].rays) kind = "-";
+            print_row(cbvh_effect_name((cbvh_effect)e), kind, &pm, fmt == CBVH_FORMAT_CBVH ? &pf[e] : NULL);
+        }
+        cbvh_fx_stats tf = total_stats(&rf), tm = total_stats(main_r);
+        pf[CBVH_FX_COUNT] = summarize(&tf, &tp);
+        pm = summarize(&tm, &tp);
+        print_row("total", "", &pm, fmt == CBVH_FORMAT_CBVH ? &pf[CBVH_FX_COUNT] : NULL);
+        int unnamed = 0;
+        for (int e = 0; e < CBVH_FX_COUNT; e++)
+            if (!d.effect[e].enabled) {
+                printf("%s %s %llu", unnamed++ ? "," : "not in the scene (rays):", cbvh_effect_name((cbvh_effect)e),
+                       (unsigned long long)main_r->fx[e].rays);
+            }
+        if (unnamed) printf("\n");
+        if (main_r->pixels_without_ray)
+            printf("pixels without a camera ray (outside the fisheye circle): %llu\n",
+                   (unsigned long long)main_r->pixels_without_ray);
+        if (tm.rejected) printf("rays rejected by a unit (no hit): %llu\n", (unsigned long long)tm.rejected);
+        print_units(&main_r->units, main_r->frames > 1);
+        printf("build%s: %.3f s CPU%s\n", main_r->frames > 1 ? " + refits" : "", main_r->build_cpu_seconds,
+               fmt == CBVH_FORMAT_CBVH ? " (CBVH: SAH build + bottom-up streaming compression)" : " (SAH build)");
+        if (fmt == CBVH_FORMAT_CBVH)
+            printf("hits: %s the float BVH's (digest %016llx)\n", status ? "DIFFERENT FROM" : "identical to",
+                   (unsigned long long)rc.hit_digest);
+    }
+    if (status) fprintf(stderr, "cbvh trace: CBVH hits differ from the float BVH (a traversal bug)\n");
+    cbvh_scene_desc_free(&d);
+    return status;
+}

@@ -1,0 +1,334 @@
+/* Effects -> rays, traced with the units of the chosen format
+ * (docs/scenes.md).  Ray generation is host-side float math (it is not a
+ * hardware unit); the traversal and every count come from the bit-exact
+ * model. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime */
+#include "effects.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define PI_F 3.14159265358979f
+
+/* ---- deterministic sampling: one splitmix64 stream per pixel sample ----- */
+typedef struct {
+    uint64_t s;
+} rng;
+
+static uint64_t mix64(uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9u;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBu;
+    return z ^ (z >> 31);
+}
+static float rnd(rng *r) {
+    r->s += 0x9E3779B97F4A7C15u;
+    return (float)(mix64(r->s) >> 40) * (1.0f / 16777216.0f); /* [0, 1) */
+}
+
+/* ---- small vector helpers ---- */
+static void sub3(float o[3], const float a[3], const float b[3]) {
+    for (int i = 0; i < 3; i++) o[i] = a[i] - b[i];
+}
+static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void cross3(float o[3], const float a[3], const float b[3]) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static void norm3(float v[3]) {
+    float l = sqrtf(dot3(v, v));
+    if (l > 0)
+        for (int i = 0; i < 3; i++) v[i] /= l;
+}
+static cbvh_f32 fbits(float f) {
+    cbvh_f32 b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+static float bitsf(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+/* Orthonormal basis (t, b) around unit n. */
+static void onb(const float n[3], float t[3], float b[3]) {
+    float a[3] = {fabsf(n[0]) > 0.9f ? 0.0f : 1.0f, fabsf(n[0]) > 0.9f ? 1.0f : 0.0f, 0.0f};
+    cross3(t, a, n);
+    norm3(t);
+    cross3(b, n, t);
+}
+static void cosine_dir(rng *r, const float n[3], float out[3]) {
+    float t[3], b[3];
+    onb(n, t, b);
+    float u1 = rnd(r), u2 = rnd(r);
+    float rad = sqrtf(u1), phi = 2 * PI_F * u2;
+    float x = rad * cosf(phi), y = rad * sinf(phi), z = sqrtf(fmaxf(0.0f, 1 - u1));
+    for (int i = 0; i < 3; i++) out[i] = x * t[i] + y * b[i] + z * n[i];
+}
+
+/* ---- the accelerator: float BVH or CBVH ---- */
+typedef struct {
+    const cbvh_scene_desc *d;
+    const cbvh_fx_opts *o;
+    cbvh_fx_result *res;
+    cbvh_bvh bvh;
+    cbvh_tree tree;
+    int have_tree;
+    cbvh_tri *tris; /* current frame */
+    float eps;      /* secondary-ray origin offset along the normal */
+    int frame;
+} tracer;
+
+static double cpu_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3], const float dir[3], float tmax,
+                 uint32_t src, int light, cbvh_trav_hit *hit) {
+    cbvh_ray r;
+    for (int a = 0; a < 3; a++) {
+        r.o[a] = fbits(o[a]);
+        r.d[a] = fbits(dir[a]);
+    }
+    r.tmin = 0;
+    r.tmax = isinf(tmax) ? CBVH_F32_POS_INF : fbits(tmax);
+    cbvh_trav_stats st = {0};
+    double t0 = cpu_now();
+    int rc = T->o->format == CBVH_FORMAT_CBVH
+                 ? cbvh_trace_cbvh(&T->tree, T->tris, &r, T->o->mant, mode, hit, &st)
+                 : cbvh_trace_bvh(&T->bvh, T->tris, &r, T->o->mant, mode, hit, &st);
+    double t1 = cpu_now();
+    cbvh_fx_stats *s = &T->res->fx[fx];
+    s->cpu_seconds += t1 - t0;
+    s->rays++;
+    if (mode == CBVH_TRAV_ANY)
+        s->any++;
+    else
+        s->closest++;
+    if (rc) {
+        s->rejected++;
+        memset(hit, 0, sizeof *hit);
+    }
+    s->hits += hit->hit != 0;
+    s->st.nodes += st.nodes;
+    s->st.box_tests += st.box_tests;
+    s->st.tri_tests += st.tri_tests;
+    s->st.lines += st.lines;
+    s->st.bytes += st.bytes;
+    if (st.max_stack > s->st.max_stack) s->st.max_stack = st.max_stack;
+    cbvh_unit_activity *u = &T->res->units;
+    u->ray_box += st.box_tests;
+    u->ray_triangle += st.tri_tests;
+    if (T->o->format == CBVH_FORMAT_CBVH) u->decoder += 6 * st.nodes;
+    /* Closest hit: triangle and t are defined (same on every format); any hit: only whether. */
+    uint64_t h = T->res->hit_digest ^
+                 (!hit->hit ? 0xFFFFFFFFFFFFFFFFu : mode == CBVH_TRAV_ANY ? 1 : ((uint64_t)hit->prim << 32 | hit->t));
+    T->res->hit_digest = mix64(h + (uint64_t)fx);
+    if (T->o->on_ray) {
+        cbvh_fx_ray fr = {fx, mode, r, src, light, T->frame, hit};
+        T->o->on_ray(T->o->ctx, &fr);
+    }
+    return hit->hit;
+}
+
+/* Hit point and the geometric normal facing the incoming ray. */
+static void surface(const tracer *T, const float o[3], const float dir[3], const cbvh_trav_hit *h, float p[3],
+                    float n[3]) {
+    float t = bitsf(h->t);
+    for (int a = 0; a < 3; a++) p[a] = o[a] + t * dir[a];
+    const cbvh_tri *tr = &T->tris[h->prim];
+    float e1[3], e2[3];
+    sub3(e1, tr->v[1], tr->v[0]);
+    sub3(e2, tr->v[2], tr->v[0]);
+    cross3(n, e1, e2);
+    norm3(n);
+    if (dot3(n, dir) > 0)
+        for (int a = 0; a < 3; a++) n[a] = -n[a];
+}
+
+static void shade(tracer *T, rng *R, const float o[3], const float dir[3], const cbvh_trav_hit *h, int depth) {
+    const cbvh_scene_desc *d = T->d;
+    float p[3], n[3], q[3];
+    surface(T, o, dir, h, p, n);
+    for (int a = 0; a < 3; a++) q[a] = p[a] + T->eps * n[a]; /* origin off the surface, on the ray's side */
+    uint32_t prim = h->prim;
+    const cbvh_effect_cfg *E = d->effect;
+    if (d->materials[d->tri_material[prim]].type == CBVH_MAT_MIRROR) {
+        /* A mirror reflects; it receives no shadows, AO or bounce. */
+        if (!E[CBVH_FX_MIRROR].enabled || depth >= E[CBVH_FX_MIRROR].max_depth) return;
+        float r[3], k = 2 * dot3(dir, n);
+        for (int a = 0; a < 3; a++) r[a] = dir[a] - k * n[a];
+        cbvh_trav_hit mh;
+        if (trace(T, CBVH_FX_MIRROR, CBVH_TRAV_CLOSEST, q, r, INFINITY, prim, -1, &mh)) shade(T, R, q, r, &mh, depth + 1);
+        return;
+    }
+    cbvh_trav_hit sh;
+    if (E[CBVH_FX_HARD_SHADOWS].enabled)
+        for (int l = 0; l < d->nlights; l++) {
+            float to[3];
+            sub3(to, d->lights[l].position, q);
+            if (dot3(to, n) <= 0) continue; /* light behind the surface: nothing to test */
+            trace(T, CBVH_FX_HARD_SHADOWS, CBVH_TRAV_ANY, q, to, 0.9999f, prim, l, &sh);
+        }
+    if (E[CBVH_FX_SOFT_SHADOWS].enabled)
+        for (int l = 0; l < d->nlights; l++) {
+            const cbvh_light *L = &d->lights[l];
+            if (L->type != CBVH_LIGHT_AREA) continue;
+            for (int s = 0; s < E[CBVH_FX_SOFT_SHADOWS].samples; s++) {
+                float a = rnd(R) - 0.5f, b = rnd(R) - 0.5f, to[3];
+                for (int i = 0; i < 3; i++) to[i] = L->position[i] + a * L->u[i] + b * L->v[i] - q[i];
+                if (dot3(to, n) <= 0) continue;
+                trace(T, CBVH_FX_SOFT_SHADOWS, CBVH_TRAV_ANY, q, to, 0.9999f, prim, l, &sh);
+            }
+        }
+    if (E[CBVH_FX_AMBIENT_OCCLUSION].enabled)
+        for (int s = 0; s < E[CBVH_FX_AMBIENT_OCCLUSION].samples; s++) {
+            float w[3];
+            cosine_dir(R, n, w);
+            trace(T, CBVH_FX_AMBIENT_OCCLUSION, CBVH_TRAV_ANY, q, w, E[CBVH_FX_AMBIENT_OCCLUSION].distance, prim, -1,
+                  &sh);
+        }
+    if (E[CBVH_FX_DIFFUSE_BOUNCE].enabled)
+        for (int s = 0; s < E[CBVH_FX_DIFFUSE_BOUNCE].samples; s++) {
+            float w[3];
+            cosine_dir(R, n, w);
+            trace(T, CBVH_FX_DIFFUSE_BOUNCE, CBVH_TRAV_CLOSEST, q, w, INFINITY, prim, -1, &sh);
+        }
+}
+
+/* Camera ray through pixel (x, y), sample s.  0 if the pixel has no ray
+ * (fisheye outside its image circle). */
+static int camera_ray(const cbvh_camera *c, int x, int y, int spp, rng *R, float o[3], float dir[3]) {
+    float w[3], u[3], v[3];
+    sub3(w, c->target, c->position);
+    norm3(w);
+    cross3(u, w, c->up);
+    norm3(u);
+    cross3(v, u, w);
+    float jx = spp > 1 ? rnd(R) : 0.5f, jy = spp > 1 ? rnd(R) : 0.5f;
+    float px = ((float)x + jx) / (float)c->width, py = ((float)y + jy) / (float)c->height; /* [0,1) */
+    memcpy(o, c->position, 3 * sizeof(float));
+    if (c->type == CBVH_CAM_FISHEYE) {
+        /* Equidistant fisheye: image circle inscribed in the frame, angle from
+         * the axis proportional to the radius, fov = full angle of the circle. */
+        float m = (float)(c->width < c->height ? c->width : c->height);
+        float cx = ((float)x + jx - 0.5f * (float)c->width) / (0.5f * m);
+        float cy = (0.5f * (float)c->height - ((float)y + jy)) / (0.5f * m);
+        float r = sqrtf(cx * cx + cy * cy);
+        if (r > 1.0f) return 0;
+        float th = r * 0.5f * c->fov * PI_F / 180.0f, ph = atan2f(cy, cx);
+        for (int i = 0; i < 3; i++)
+            dir[i] = cosf(th) * w[i] + sinf(th) * (cosf(ph) * u[i] + sinf(ph) * v[i]);
+        return 1;
+    }
+    float th = tanf(0.5f * c->fov * PI_F / 180.0f), aspect = (float)c->width / (float)c->height;
+    float sx = (2 * px - 1) * th * aspect, sy = (1 - 2 * py) * th;
+    for (int i = 0; i < 3; i++) dir[i] = w[i] + sx * u[i] + sy * v[i];
+    if (c->type == CBVH_CAM_THIN_LENS) {
+        /* Point in focus at distance focus_distance along the axis; origin on
+         * the lens disk of radius `aperture`. */
+        float f[3], rr = c->aperture * sqrtf(rnd(R)), ph = 2 * PI_F * rnd(R);
+        for (int i = 0; i < 3; i++) f[i] = c->position[i] + c->focus_distance * dir[i];
+        for (int i = 0; i < 3; i++) o[i] = c->position[i] + rr * cosf(ph) * u[i] + rr * sinf(ph) * v[i];
+        sub3(dir, f, o);
+    }
+    return 1;
+}
+
+static void trace_frame(tracer *T) {
+    const cbvh_scene_desc *d = T->d;
+    const cbvh_camera *c = &d->camera;
+    int spp = T->o->spp > 0 ? T->o->spp : c->spp, frames = cbvh_scene_desc_frames(d);
+    for (int y = 0; y < c->height; y++) {
+        if (T->o->progress) T->o->progress(T->o->ctx, T->frame, frames, y, c->height);
+        for (int x = 0; x < c->width; x++)
+            for (int s = 0; s < spp; s++) {
+                uint64_t pix = ((uint64_t)y * (uint64_t)c->width + (uint64_t)x) * (uint64_t)spp + (uint64_t)s;
+                rng R = {mix64(d->seed * 0x9E3779B97F4A7C15u ^ mix64(pix + ((uint64_t)T->frame << 40)))};
+                float o[3], dir[3];
+                if (!camera_ray(c, x, y, spp, &R, o, dir)) {
+                    T->res->pixels_without_ray++;
+                    continue;
+                }
+                cbvh_trav_hit h;
+                if (trace(T, CBVH_FX_PRIMARY, CBVH_TRAV_CLOSEST, o, dir, INFINITY, UINT32_MAX, -1, &h))
+                    shade(T, &R, o, dir, &h, 0);
+            }
+    }
+}
+
+static int compress(tracer *T, const cbvh_tri *refit, char *err, size_t errlen) {
+    cbvh_compress_opts co = {T->o->params, CBVH_ENC_MODULO, 1, 0};
+    cbvh_tree nt;
+    cbvh_bu_stats bs;
+    if (cbvh_compress_bottomup(&T->bvh, refit, &co, &nt, &bs, err, errlen)) return -1;
+    if (T->have_tree) cbvh_tree_free(&T->tree);
+    T->tree = nt;
+    T->have_tree = 1;
+    T->res->units.compressor += 6 * (bs.encodes + bs.reencodes) + 3;
+    return 0;
+}
+
+int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen) {
+    memset(r, 0, sizeof *r);
+    if (o->mant < CBVH_MANT_MIN || o->mant > CBVH_MANT_MAX) {
+        snprintf(err, errlen, "--mant %d out of range %d..%d", o->mant, CBVH_MANT_MIN, CBVH_MANT_MAX);
+        return -1;
+    }
+    if (o->format == CBVH_FORMAT_CBVH && cbvh_params_check(&o->params)) {
+        snprintf(err, errlen, "bad CBVH parameters N=%d min_scale=%d (N in %d..%d, min_scale in -126..126)",
+                 o->params.quant_bits, o->params.min_scale, CBVH_N_MIN, CBVH_N_MAX);
+        return -1;
+    }
+    tracer T = {.d = d, .o = o, .res = r};
+    r->frames = cbvh_scene_desc_frames(d);
+    r->ntris = d->mesh.ntris;
+    T.tris = malloc((size_t)d->mesh.ntris * sizeof *T.tris);
+    if (!T.tris) abort();
+    cbvh_scene_desc_frame(d, 0, T.tris);
+    cbvh_scene frame0 = d->mesh;
+    frame0.tris = T.tris;
+    float lo[3], hi[3];
+    cbvh_scene_bounds(&frame0, lo, hi);
+    float dg[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    T.eps = 1e-4f * sqrtf(dot3(dg, dg));
+    if (!(T.eps > 0)) T.eps = 1e-6f;
+    int rc = -1;
+    double b0 = cpu_now();
+    if (cbvh_build_sah(&frame0, 0, 0, &T.bvh, err, errlen)) {
+        free(T.tris);
+        return -1;
+    }
+    if (o->format == CBVH_FORMAT_CBVH) {
+        if (compress(&T, NULL, err, errlen)) goto out;
+        r->node_bytes = cbvh_tree_bytes(&T.tree);
+    } else
+        r->node_bytes = cbvh_bvh_bytes(&T.bvh);
+    r->build_cpu_seconds = cpu_now() - b0;
+    for (T.frame = 0; T.frame < r->frames; T.frame++) {
+        if (T.frame > 0) {
+            /* Animation: move the vertices and refit (never for a static scene). */
+            cbvh_scene_desc_frame(d, T.frame, T.tris);
+            double t0 = cpu_now();
+            if (o->format == CBVH_FORMAT_CBVH) {
+                if (compress(&T, T.tris, err, errlen)) goto out; /* streaming refit */
+            } else
+                cbvh_bvh_refit(&T.bvh, T.tris);
+            r->build_cpu_seconds += cpu_now() - t0;
+            r->units.refit += T.bvh.nnodes;
+            r->refits++;
+        }
+        trace_frame(&T);
+    }
+    rc = 0;
+out:
+    if (T.have_tree) cbvh_tree_free(&T.tree);
+    cbvh_bvh_free(&T.bvh);
+    free(T.tris);
+    return rc;
+}

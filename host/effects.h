@@ -1,0 +1,73 @@
+/* Effects -> rays (docs/scenes.md §Effects): generate only the rays the
+ * scene's effects call for, trace them with the units the chosen format needs
+ * (float BVH or CBVH), and count the cost per effect and the activity of every
+ * unit.  Sampling is deterministic (seeded per pixel and sample), so the float
+ * BVH and the CBVH see the same rays and, since their hits are identical
+ * (docs/traversal.md §5), spawn the same secondary rays. */
+#ifndef CBVH_HOST_EFFECTS_H
+#define CBVH_HOST_EFFECTS_H
+
+#include <stdint.h>
+
+#include "cbvh/traverse.h"
+#include "scene_file.h"
+
+typedef enum { CBVH_FORMAT_FLOAT = 0, CBVH_FORMAT_CBVH = 1 } cbvh_accel_format;
+
+/* One traced ray, as the observer sees it. */
+typedef struct {
+    cbvh_effect effect;
+    cbvh_trav_mode mode;   /* closest hit (primary, mirror, bounce) or any hit (shadows, AO) */
+    cbvh_ray ray;
+    uint32_t source_prim;  /* triangle the ray leaves from; UINT32_MAX for camera rays */
+    int light;             /* shadow rays: the light aimed at; else -1 */
+    int frame;
+    const cbvh_trav_hit *hit;
+} cbvh_fx_ray;
+
+typedef struct {
+    cbvh_accel_format format;
+    cbvh_params params; /* N and min_scale of the CBVH */
+    int mant;           /* M of the ray-box unit (3..24) */
+    int spp;            /* camera samples per pixel; 0 = the scene's */
+    void (*on_ray)(void *ctx, const cbvh_fx_ray *r);       /* optional observer */
+    void (*progress)(void *ctx, int frame, int frames, int row, int rows); /* optional */
+    void *ctx;
+} cbvh_fx_opts;
+
+typedef struct {
+    uint64_t rays;            /* rays traced */
+    uint64_t closest, any;    /* traversals by kind */
+    uint64_t hits;
+    uint64_t rejected;        /* rays a unit rejected (NaN/Inf, zero direction): no hit */
+    cbvh_trav_stats st;       /* summed counters; max_stack = deepest */
+    double cpu_seconds;       /* process CPU time spent in traversal */
+} cbvh_fx_stats;
+
+/* Invocations per unit (docs/scenes.md §Units). */
+typedef struct {
+    uint64_t compressor;   /* axis compressions: 6 per node-pair encode or re-encode, 3 per root context */
+    uint64_t decoder;      /* axis decodes: 6 per node pair fetched by a CBVH traversal */
+    uint64_t ray_box;      /* ray-box tests */
+    uint64_t ray_triangle; /* ray-triangle tests */
+    uint64_t refit;        /* node boxes recomputed by refits (animated scenes only) */
+} cbvh_unit_activity;
+
+typedef struct {
+    cbvh_fx_stats fx[CBVH_FX_COUNT];
+    cbvh_unit_activity units;
+    int frames;
+    uint32_t ntris;
+    uint64_t node_bytes;     /* hierarchy + primitive IDs (frame 0) */
+    uint64_t refits;         /* refit passes */
+    uint64_t pixels_without_ray; /* fisheye pixels outside the image circle */
+    uint64_t hit_digest;     /* hash of every ray's hit (prim, t bits) */
+    double build_cpu_seconds;
+} cbvh_fx_result;
+
+/* Builds the float BVH (binned SAH) of frame 0, compresses it (format cbvh,
+ * bottom-up streaming), and for every frame: refits (frames >= 1), then traces
+ * every enabled effect.  0, or -1 with a one-line reason. */
+int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen);
+
+#endif

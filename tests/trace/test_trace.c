@@ -1,0 +1,394 @@
+/* Scenes call for effects (docs/scenes.md) and the timing model
+ * (docs/timing_model.md):
+ *   - an effect not named produces no rays and no unit activity; a static
+ *     scene never runs the refit unit, an animated one does; the float format
+ *     never runs the compressor or decoder;
+ *   - every effect's rays are of the right kind (any-hit shadow rays aimed at
+ *     the lights, mirror rays only from mirror surfaces, ...);
+ *   - CBVH and float BVH see the same rays and the same hits;
+ *   - scene-file errors give the right one-line message;
+ *   - the timing model computes what its doc says on a hand-checked example. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "effects.h"
+#include "scene_file.h"
+#include "timing_model.h"
+
+#define MESH CBVH_SCENES_DIR "/bunny-small.obj"
+#define CAMERA                                                                                                  \
+    "\"camera\": {\"width\": 24, \"height\": 18, \"position\": [0, 6, 22], \"target\": [0, 4.2, 0], \"fov\": 35}"
+
+static void load(const char *json, cbvh_scene_desc *d) {
+    char err[512];
+    int rc = cbvh_scene_file_parse(json, "t.scene", d, err, sizeof err);
+    if (rc) fprintf(stderr, "parse failed: %s\n", err);
+    assert_int_equal(rc, 0);
+}
+
+static cbvh_fx_opts opts(cbvh_accel_format f) {
+    cbvh_fx_opts o = {f, {6, CBVH_MIN_SCALE_DEFAULT}, 24, 0, NULL, NULL, NULL};
+    return o;
+}
+
+static void run(const cbvh_scene_desc *d, cbvh_fx_opts *o, cbvh_fx_result *r) {
+    char err[512];
+    int rc = cbvh_fx_run(d, o, r, err, sizeof err);
+    if (rc) fprintf(stderr, "run failed: %s\n", err);
+    assert_int_equal(rc, 0);
+}
+
+/* ---- observer: checks every ray against what its effect calls for ---- */
+typedef struct {
+    const cbvh_scene_desc *d;
+    uint64_t rays[CBVH_FX_COUNT];
+    long bad;
+} watch;
+
+static float bf(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+static void on_ray(void *ctx, const cbvh_fx_ray *r) {
+    watch *w = ctx;
+    const cbvh_scene_desc *d = w->d;
+    w->rays[r->effect]++;
+    int any = r->effect == CBVH_FX_HARD_SHADOWS || r->effect == CBVH_FX_SOFT_SHADOWS ||
+              r->effect == CBVH_FX_AMBIENT_OCCLUSION;
+    if ((r->mode == CBVH_TRAV_ANY) != any) w->bad++;
+    if (r->effect == CBVH_FX_PRIMARY) {
+        if (r->source_prim != UINT32_MAX) w->bad++;
+        return;
+    }
+    if (r->source_prim >= d->mesh.ntris) {
+        w->bad++;
+        return;
+    }
+    int mirror = d->materials[d->tri_material[r->source_prim]].type == CBVH_MAT_MIRROR;
+    if (mirror != (r->effect == CBVH_FX_MIRROR)) w->bad++; /* mirror rays from mirrors only, the rest from diffuse */
+    float o[3], dir[3];
+    for (int a = 0; a < 3; a++) o[a] = bf(r->ray.o[a]), dir[a] = bf(r->ray.d[a]);
+    if (r->effect == CBVH_FX_HARD_SHADOWS || r->effect == CBVH_FX_SOFT_SHADOWS) {
+        /* Aimed at the light: o + d is on it, tmax just short of it. */
+        if (r->light < 0 || r->light >= d->nlights || !(bf(r->ray.tmax) < 1.0f && bf(r->ray.tmax) > 0.99f)) {
+            w->bad++;
+            return;
+        }
+        const cbvh_light *L = &d->lights[r->light];
+        float rel[3];
+        for (int a = 0; a < 3; a++) rel[a] = o[a] + dir[a] - L->position[a];
+        if (r->effect == CBVH_FX_HARD_SHADOWS) {
+            for (int a = 0; a < 3; a++)
+                if (fabsf(rel[a]) > 1e-3f) w->bad++;
+        } else {
+            if (L->type != CBVH_LIGHT_AREA) w->bad++;
+            /* rel = a u + b v with |a|, |b| <= 1/2 (u, v orthogonal in the test scenes) */
+            float uu = L->u[0] * L->u[0] + L->u[1] * L->u[1] + L->u[2] * L->u[2];
+            float vv = L->v[0] * L->v[0] + L->v[1] * L->v[1] + L->v[2] * L->v[2];
+            float a = (rel[0] * L->u[0] + rel[1] * L->u[1] + rel[2] * L->u[2]) / uu;
+            float b = (rel[0] * L->v[0] + rel[1] * L->v[1] + rel[2] * L->v[2]) / vv;
+            if (fabsf(a) > 0.5001f || fabsf(b) > 0.5001f) w->bad++;
+        }
+    } else if (r->effect == CBVH_FX_AMBIENT_OCCLUSION) {
+        if (fabsf(bf(r->ray.tmax) - d->effect[CBVH_FX_AMBIENT_OCCLUSION].distance) > 0) w->bad++;
+        float l = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (fabsf(l - 1.0f) > 1e-3f) w->bad++;
+    } else if (r->ray.tmax != CBVH_F32_POS_INF)
+        w->bad++; /* mirror and bounce rays are unbounded */
+}
+
+static const char *all_fx_scene =
+    "{\"mesh\": \"" MESH "\", " CAMERA ","
+    "\"lights\": [{\"type\": \"point\", \"position\": [8, 16, 10]},"
+    "             {\"type\": \"area\", \"position\": [-6, 14, 8], \"u\": [3, 0, 0], \"v\": [0, 0, 3]}],"
+    "\"materials\": [{\"name\": \"clay\", \"type\": \"diffuse\"}, {\"name\": \"chrome\", \"type\": \"mirror\"}],"
+    "\"mesh_material\": \"clay\", \"floor\": {\"material\": \"chrome\", \"size\": 3},"
+    "\"effects\": [\"primary\", \"hard_shadows\", {\"effect\": \"soft_shadows\", \"samples\": 3},"
+    "  {\"effect\": \"ambient_occlusion\", \"samples\": 2, \"distance\": 1.5}, {\"effect\": \"mirror\", \"max_depth\": 2},"
+    "  {\"effect\": \"diffuse_bounce\", \"samples\": 2}]}";
+
+/* Only primary: zero rays of every other effect, zero any-hit traversals, no
+ * refit; float format: no compressor, no decoder. */
+static void primary_only(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA
+         ", \"lights\": [{\"type\": \"point\", \"position\": [8, 16, 10]}], \"effects\": [\"primary\"]}",
+         &d);
+    for (int f = 0; f < 2; f++) {
+        cbvh_fx_opts o = opts(f ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT);
+        watch w = {&d, {0}, 0};
+        o.on_ray = on_ray;
+        o.ctx = &w;
+        cbvh_fx_result r;
+        run(&d, &o, &r);
+        assert_int_equal(w.bad, 0);
+        assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays, 24 * 18);
+        assert_int_equal(w.rays[CBVH_FX_PRIMARY], 24 * 18);
+        assert_true(r.fx[CBVH_FX_PRIMARY].hits > 0);
+        assert_int_equal(r.fx[CBVH_FX_PRIMARY].any, 0);
+        for (int e = 1; e < CBVH_FX_COUNT; e++) {
+            assert_int_equal(r.fx[e].rays, 0);
+            assert_int_equal(w.rays[e], 0);
+            assert_int_equal(r.fx[e].st.box_tests + r.fx[e].st.tri_tests + r.fx[e].st.bytes, 0);
+        }
+        assert_int_equal(r.units.refit, 0);
+        assert_int_equal(r.refits, 0);
+        assert_int_equal(r.units.ray_box, r.fx[CBVH_FX_PRIMARY].st.box_tests);
+        assert_int_equal(r.units.ray_triangle, r.fx[CBVH_FX_PRIMARY].st.tri_tests);
+        if (f) {
+            assert_true(r.units.compressor > 0);
+            assert_int_equal(r.units.decoder, 6 * r.fx[CBVH_FX_PRIMARY].st.nodes);
+        } else {
+            assert_int_equal(r.units.compressor, 0);
+            assert_int_equal(r.units.decoder, 0);
+        }
+    }
+    cbvh_scene_desc_free(&d);
+}
+
+/* Every effect named: each produces rays of its kind; CBVH = float BVH on the
+ * same rays (same counts per effect, same hits). */
+static void all_effects(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load(all_fx_scene, &d);
+    cbvh_fx_result r[2];
+    for (int f = 0; f < 2; f++) {
+        cbvh_fx_opts o = opts(f ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT);
+        watch w = {&d, {0}, 0};
+        o.on_ray = on_ray;
+        o.ctx = &w;
+        run(&d, &o, &r[f]);
+        assert_int_equal(w.bad, 0);
+        for (int e = 0; e < CBVH_FX_COUNT; e++) {
+            assert_true(r[f].fx[e].rays > 0);
+            assert_int_equal(w.rays[e], r[f].fx[e].rays);
+            int any = e == CBVH_FX_HARD_SHADOWS || e == CBVH_FX_SOFT_SHADOWS || e == CBVH_FX_AMBIENT_OCCLUSION;
+            assert_int_equal(any ? r[f].fx[e].closest : r[f].fx[e].any, 0);
+        }
+        assert_int_equal(r[f].units.refit, 0);
+    }
+    assert_int_equal(r[0].hit_digest, r[1].hit_digest);
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        assert_int_equal(r[0].fx[e].rays, r[1].fx[e].rays);
+        assert_int_equal(r[0].fx[e].hits, r[1].fx[e].hits);
+        assert_true(r[1].fx[e].st.box_tests >= r[0].fx[e].st.box_tests); /* CBVH boxes enclose the float ones */
+    }
+    /* Soft shadows: 3 samples per area light per lit point, so a multiple of 3. */
+    assert_int_equal(r[1].fx[CBVH_FX_SOFT_SHADOWS].rays % 3, 0);
+    /* Deterministic: the same run gives the same digest. */
+    cbvh_fx_opts o = opts(CBVH_FORMAT_CBVH);
+    cbvh_fx_result again;
+    run(&d, &o, &again);
+    assert_int_equal(again.hit_digest, r[1].hit_digest);
+    cbvh_scene_desc_free(&d);
+}
+
+/* Removing mirrors from the scene removes every mirror ray. */
+static void no_mirror_material(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA ", \"floor\": {}, \"effects\": [\"primary\", \"mirror\"]}", &d);
+    cbvh_fx_opts o = opts(CBVH_FORMAT_CBVH);
+    cbvh_fx_result r;
+    run(&d, &o, &r);
+    assert_true(r.fx[CBVH_FX_PRIMARY].hits > 0);
+    assert_int_equal(r.fx[CBVH_FX_MIRROR].rays, 0);
+    cbvh_scene_desc_free(&d);
+}
+
+/* Animation forces refits (frames - 1 of them, on both formats); the static
+ * scene above never refits. */
+static void animated_refits(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"],"
+         "\"animation\": {\"type\": \"twist\", \"frames\": 3, \"amount\": 0.8}}",
+         &d);
+    for (int f = 0; f < 2; f++) {
+        cbvh_fx_opts o = opts(f ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT);
+        cbvh_fx_result r;
+        run(&d, &o, &r);
+        assert_int_equal(r.frames, 3);
+        assert_int_equal(r.refits, 2);
+        assert_true(r.units.refit > 0);
+        assert_int_equal(r.units.refit % 2, 0);
+        assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays, 3 * 24 * 18);
+        for (int e = 1; e < CBVH_FX_COUNT; e++) assert_int_equal(r.fx[e].rays, 0);
+    }
+    /* The frames really move: frame 2 differs from frame 0. */
+    cbvh_tri *a = malloc(d.mesh.ntris * sizeof *a), *b = malloc(d.mesh.ntris * sizeof *b);
+    cbvh_scene_desc_frame(&d, 0, a);
+    cbvh_scene_desc_frame(&d, 2, b);
+    assert_true(memcmp(a, b, d.mesh.ntris * sizeof *a) != 0);
+    free(a);
+    free(b);
+    cbvh_scene_desc_free(&d);
+}
+
+/* Cameras: fisheye leaves the corners without rays; thin lens shoots spp
+ * rays per pixel from different lens points. */
+static void cameras(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", \"camera\": {\"type\": \"fisheye\", \"width\": 20, \"height\": 20,"
+         "\"position\": [0, 5, 9], \"target\": [0, 4.2, 0]}, \"effects\": [\"primary\"]}",
+         &d);
+    cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
+    cbvh_fx_result r;
+    run(&d, &o, &r);
+    assert_true(r.pixels_without_ray > 0);
+    assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays + r.pixels_without_ray, 400);
+    cbvh_scene_desc_free(&d);
+    load("{\"mesh\": \"" MESH "\", \"camera\": {\"type\": \"thin_lens\", \"width\": 8, \"height\": 6, \"spp\": 3,"
+         "\"position\": [0, 6, 22], \"target\": [0, 4.2, 0], \"aperture\": 0.5}, \"effects\": [\"primary\"]}",
+         &d);
+    assert_float_equal(d.camera.focus_distance, sqrtf(6 * 6 * 0.09f + 22 * 22), 1e-3);
+    o.spp = 2; /* --spp overrides camera.spp */
+    run(&d, &o, &r);
+    assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays, 8 * 6 * 2);
+    cbvh_scene_desc_free(&d);
+}
+
+/* ---- scene-file errors: one line, naming the field ---- */
+static void errors(void **state) {
+    (void)state;
+    static const struct {
+        const char *json, *msg;
+    } cases[] = {
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\", \"caustics\"]}",
+         "t.scene: effects[1]: unknown effect 'caustics'"},
+        {"{\"mesh\": \"no/such/mesh.obj\", " CAMERA ", \"effects\": [\"primary\"]}", "t.scene: mesh: "},
+        {"{" CAMERA ", \"effects\": [\"primary\"]}", "t.scene: mesh: missing"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"width\": \"wide\", \"position\": [0,0,1], \"target\": [0,0,0]},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.width: expected an integer in 1..4096"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"width\": 2.5, \"position\": [0,0,1], \"target\": [0,0,0]},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.width: expected an integer"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"fov\": -5, \"position\": [0,0,1], \"target\": [0,0,0]},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.fov: -5 is out of range (0, 179]"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"position\": [0,0,1], \"target\": [0,0]}, \"effects\": [\"primary\"]}",
+         "t.scene: camera.target: expected [x, y, z]"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"position\": [0,0,1], \"target\": [0,0,1]}, \"effects\": [\"primary\"]}",
+         "t.scene: camera.target: equals camera.position"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"fovv\": 3, \"position\": [0,0,1], \"target\": [0,0,0]},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.fovv: unknown field"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"position\": [0,0,1], \"target\": [0,0,0], \"aperture\": 1},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.aperture: only for \"type\": \"thin_lens\""},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"type\": \"thin_lens\", \"position\": [0,0,1], \"target\": [0,0,0]},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.aperture: missing"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"type\": \"ortho\", \"position\": [0,0,1], \"target\": [0,0,0]},"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: camera.type: unknown camera 'ortho'"},
+        {"{\"mesh\": \"" MESH "\", \"effects\": [\"primary\"]}", "t.scene: camera: missing"},
+        {"{\"mesh\": \"" MESH "\",\n " CAMERA ",\n \"effects\": [\"primary\",]}", "t.scene: line 3: not valid JSON"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\", \"hard_shadows\"]}",
+         "t.scene: effects: 'hard_shadows' needs at least one light"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"lights\": [{\"type\": \"point\", \"position\": [0,9,0]}],"
+         "\"effects\": [\"primary\", \"soft_shadows\"]}",
+         "t.scene: effects: 'soft_shadows' needs at least one area light"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"ambient_occlusion\"]}",
+         "t.scene: effects: 'ambient_occlusion' needs 'primary'"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\", \"primary\"]}",
+         "t.scene: effects[1]: effect 'primary' listed twice"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": []}", "t.scene: effects: empty"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [{\"effect\": \"ambient_occlusion\", \"samples\": 0}]}",
+         "t.scene: effects[0](ambient_occlusion).samples: expected an integer in 1..4096"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\", {\"effect\": \"mirror\", \"samples\": 2}]}",
+         "t.scene: effects[1](mirror).samples: unknown field"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"lights\": [{\"type\": \"spot\", \"position\": [0,9,0]}],"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: lights[0].type: unknown light 'spot'"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"lights\": [{\"type\": \"area\", \"position\": [0,9,0]}],"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: lights[0].u: missing"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"materials\": [{\"name\": \"m\", \"type\": \"glass\"}],"
+         "\"effects\": [\"primary\"]}",
+         "t.scene: materials[0].type: unknown material 'glass'"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"mesh_material\": \"gold\", \"effects\": [\"primary\"]}",
+         "t.scene: mesh_material: no material named 'gold'"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"animation\": {\"type\": \"morph\"}}",
+         "t.scene: animation.type: 'morph' but mesh"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"animation\": {\"type\": \"twist\","
+         "\"frames\": 1}}",
+         "t.scene: animation.frames: expected an integer in 2..1000"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"clock_mhz\": 0}}",
+         "t.scene: timing.clock_mhz: 0 is out of range (0, 1e+09]"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"shadows\": true}",
+         "t.scene: shadows: unknown field"},
+        {"[1, 2]", "t.scene: expected a JSON object at the top level"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cbvh_scene_desc d;
+        char err[512] = "";
+        int rc = cbvh_scene_file_parse(cases[i].json, "t.scene", &d, err, sizeof err);
+        if (rc != -1 || strncmp(err, cases[i].msg, strlen(cases[i].msg)) != 0 || strchr(err, '\n'))
+            fprintf(stderr, "case %zu: rc %d, got '%s', want '%s...'\n", i, rc, err, cases[i].msg);
+        assert_int_equal(rc, -1);
+        assert_true(strncmp(err, cases[i].msg, strlen(cases[i].msg)) == 0);
+        assert_null(strchr(err, '\n'));
+        assert_null(d.mesh.tris); /* nothing half-loaded */
+    }
+    /* A relative mesh path is looked up next to the scene file. */
+    cbvh_scene_desc d;
+    char err[512];
+    int rc = cbvh_scene_file_parse("{\"mesh\": \"bunny-small.obj\", " CAMERA ", \"effects\": [\"primary\"]}",
+                                   CBVH_SCENES_DIR "/x.scene", &d, err, sizeof err);
+    assert_int_equal(rc, 0);
+    assert_int_equal(d.mesh.ntris, 3674);
+    cbvh_scene_desc_free(&d);
+}
+
+/* docs/timing_model.md, worked example. */
+static void timing_example(void **state) {
+    (void)state;
+    cbvh_timing_params p = {2, 5, 100, 12.8, 500};
+    cbvh_timing_work w = {10, 3, 4, 640};
+    cbvh_timing_result r;
+    assert_int_equal(cbvh_timing_eval(&p, &w, &r), 0);
+    assert_float_equal(r.compute_cycles, 35.0, 1e-12);   /* 10*2 + 3*5 */
+    assert_float_equal(r.latency_cycles, 700.0, 1e-12);  /* (4 + 3) * 100 */
+    assert_float_equal(r.transfer_cycles, 50.0, 1e-12);  /* 640 / 12.8 */
+    assert_float_equal(r.cycles, 785.0, 1e-12);
+    assert_float_equal(r.seconds, 1.57e-6, 1e-18);       /* 785 / 500 MHz */
+    cbvh_timing_params dflt;
+    cbvh_timing_defaults(&dflt);
+    assert_float_equal(dflt.box_cycles, 1.0, 0);
+    assert_float_equal(dflt.tri_cycles, 1.0, 0);
+    assert_float_equal(dflt.fetch_latency, 100.0, 0);
+    assert_float_equal(dflt.dram_bytes_per_cycle, 12.8, 0);
+    assert_float_equal(dflt.clock_mhz, 1000.0, 0);
+    assert_int_equal(cbvh_timing_eval(&dflt, &w, &r), 0);
+    assert_float_equal(r.cycles, 10 + 3 + 700 + 50, 1e-12);
+    assert_float_equal(r.seconds, 763e-9, 1e-18);
+    cbvh_timing_params bad = p;
+    bad.dram_bytes_per_cycle = 0;
+    assert_int_equal(cbvh_timing_eval(&bad, &w, &r), -1);
+    bad = p;
+    bad.box_cycles = -1;
+    assert_int_equal(cbvh_timing_eval(&bad, &w, &r), -1);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(primary_only), cmocka_unit_test(all_effects), cmocka_unit_test(no_mirror_material),
+        cmocka_unit_test(animated_refits), cmocka_unit_test(cameras), cmocka_unit_test(errors),
+        cmocka_unit_test(timing_example),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
