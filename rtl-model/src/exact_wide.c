@@ -251,6 +251,49 @@ cbvh_f32 cbvh_xw_div_round(const cbvh_xw *a, const cbvh_xw *b, int bits, cbvh_rn
         goto rounded_q;
     }
 #endif
+#ifdef __SIZEOF_INT128__
+    {
+        /* Wide operands: estimate Q from the top 64 bits of B' = |b| << sb and
+         * the same bit range of A (Q_est - 2 <= Q <= Q_est + 1, since
+         * B' >= 2^64), then correct exactly: R = A - (Q_est - 2) B' and subtract
+         * B' while R >= B' (at most 4 times).  Same Q and sticky as the
+         * bit-by-bit division below, in one multiply-subtract pass. */
+        typedef unsigned __int128 u128;
+        nb = mag_shl(B, b->m, b->n, sb);
+        int pos = mag_bitlen(B, nb) - 64; /* > 0 here */
+        uint64_t bt = 0;
+        u128 at = 0;
+        for (int i = pos / 32; i < nb; i++) {
+            int sh = 32 * i - pos;
+            bt |= sh >= 0 ? (uint64_t)B[i] << sh : (uint64_t)B[i] >> -sh;
+        }
+        for (int i = pos / 32; i < na; i++) {
+            int sh = 32 * i - pos;
+            at |= sh >= 0 ? (u128)A[i] << sh : (u128)(A[i] >> -sh);
+        }
+        u128 qe128 = at / bt;
+        uint32_t q0 = qe128 >= 2 ? (uint32_t)(qe128 - 2) : 0; /* < 2^(P+1) <= 2^27 */
+        uint32_t T[L + 3];
+        uint64_t c = 0;
+        need(nb + 1);
+        for (int i = 0; i < nb; i++) {
+            c += (uint64_t)B[i] * q0;
+            T[i] = (uint32_t)c;
+            c >>= 32;
+        }
+        T[nb] = (uint32_t)c;
+        int nt = nb + 1;
+        while (nt > 0 && T[nt - 1] == 0) nt--;
+        na = mag_sub(A, A, na, T, nt); /* A >= q0 B' */
+        q = q0;
+        while (mag_cmp(A, na, B, nb) >= 0) {
+            na = mag_sub(A, A, na, B, nb);
+            q++;
+        }
+        sticky = na != 0;
+        goto rounded_q;
+    }
+#endif
     nb = mag_shl(B, b->m, b->n, sb + P); /* B << P: the top quotient bit */
     /* A / B < 2^(P+1): restoring division, P + 1 quotient bits. */
     for (int i = P; i >= 0; i--) {

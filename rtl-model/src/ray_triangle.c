@@ -13,9 +13,10 @@
 
 #include "cbvh/traversal_units.h"
 #include "exact_wide.h"
+#include "ray_prep.h"
 
-uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
-                           cbvh_tri_result *out) {
+uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
+                                      const cbvh_f32 v2[3], cbvh_tri_result *out) {
     memset(out, 0, sizeof *out);
     int bad = 0;
     for (int a = 0; a < 3; a++)
@@ -94,4 +95,100 @@ uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh
     out->b1 = cbvh_xw_div_round(&E[1], &det, 24, CBVH_RND_DOWN);
     out->b2 = cbvh_xw_div_round(&E[2], &det, 24, CBVH_RND_DOWN);
     return 0;
+}
+
+/* ---------------------------------------------------------------------------
+ * Miss filter (docs/traversal.md, "Performance filter").  Most triangles a
+ * traversal tests are misses; the filter proves a miss in binary64 with a
+ * rigorous error bound and returns the exact path's miss result (hit 0, all
+ * outputs +0, status 0).  Anything it cannot prove (every hit, every
+ * near-boundary case) goes to the exact path, which alone computes outputs,
+ * so the unit's results stay integer-defined: the filter chooses between two
+ * computations proven to give the same outputs.
+ *
+ * Error bound: every quantity is a polynomial in the binary32 inputs, each
+ * evaluated as a tree of +, -, x.  With u = 2^-53, and no underflow or
+ * overflow (binary32 inputs keep every nonzero intermediate magnitude within
+ * [2^-960, 2^650]), the computed y^ satisfies |y^ - y| <= gamma_k * A where k
+ * is the number of roundings on the deepest path and A is the same
+ * expression on absolute values with - read as + (Higham, ASNA 2nd ed.,
+ * sec. 3.1-3.3).  A is itself computed with + and x only, A^ >= A (1 - gamma_k).
+ * Depths: P = v - o 1, X = P_x d_z - P_z d_x 3, U = X_2 Y_1 - Y_2 X_1 5,
+ * T = U Z_0 + V Z_1 + W Z_2 9.  So |U^ - U| <= 6u A^_U < 2^-48 A^_U and
+ * |T^ - T| <= 10u A^_T < 2^-47 A^_T, and |y^| > bound proves sign(y^) =
+ * sign(y).  A fused multiply-add only removes roundings, so the bound also
+ * holds if the compiler contracts (the file is compiled with
+ * -ffp-contract=off anyway, so the filter's decisions are reproducible). */
+static double dabs(double x) { return x < 0 ? -x : x; }
+static double f32d(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return (double)f;
+}
+
+/* 1: certainly a miss; 0: undecided (the exact path decides). */
+static int filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3]) {
+    int kz = 0;
+    for (int a = 1; a < 3; a++)
+        if ((ray->d[a] & ~CBVH_F32_SIGN) > (ray->d[kz] & ~CBVH_F32_SIGN)) kz = a;
+    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+    if (ray->d[kz] & CBVH_F32_SIGN) {
+        int t = kx;
+        kx = ky;
+        ky = t;
+    }
+    double dx = f32d(ray->d[kx]), dy = f32d(ray->d[ky]), dz = f32d(ray->d[kz]);
+    double adx = dabs(dx), ady = dabs(dy), adz = dabs(dz);
+    double ox = f32d(ray->o[kx]), oy = f32d(ray->o[ky]), oz = f32d(ray->o[kz]);
+    double aox = dabs(ox), aoy = dabs(oy), aoz = dabs(oz);
+    const cbvh_f32 *v[3] = {v0, v1, v2};
+    double X[3], Y[3], Z[3], AX[3], AY[3], AZ[3];
+    for (int i = 0; i < 3; i++) {
+        double vx = f32d(v[i][kx]), vy = f32d(v[i][ky]), vz = f32d(v[i][kz]);
+        double px = vx - ox, py = vy - oy, pz = vz - oz;
+        double apx = dabs(vx) + aox, apy = dabs(vy) + aoy, apz = dabs(vz) + aoz;
+        X[i] = px * dz - pz * dx;
+        Y[i] = py * dz - pz * dy;
+        Z[i] = pz;
+        AX[i] = apx * adz + apz * adx;
+        AY[i] = apy * adz + apz * ady;
+        AZ[i] = apz;
+    }
+    double E[3], AE[3];
+    int sg[3];
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        E[i] = X[k] * Y[j] - Y[k] * X[j];
+        AE[i] = AX[k] * AY[j] + AY[k] * AX[j];
+        double b = AE[i] * 0x1p-48;
+        sg[i] = E[i] > b ? 1 : E[i] < -b ? -1 : 0; /* 0: sign unknown */
+    }
+    if ((sg[0] < 0 || sg[1] < 0 || sg[2] < 0) && (sg[0] > 0 || sg[1] > 0 || sg[2] > 0)) return 1;
+    if (sg[0] == 0 || sg[0] != sg[1] || sg[1] != sg[2]) return 0;
+    /* U, V, W certainly of one strict sign: det has that sign, det != 0 */
+    double T = E[0] * Z[0] + E[1] * Z[1] + E[2] * Z[2];
+    double AT = AE[0] * AZ[0] + AE[1] * AZ[1] + AE[2] * AZ[2];
+    double b = AT * 0x1p-47;
+    int sT = T > b ? 1 : T < -b ? -1 : 0;
+    int sden = sg[0] * (dz > 0 ? 1 : -1); /* d_z != 0: the largest |d| of a nonzero d */
+    return sT != 0 && sT != sden;
+}
+
+uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                           cbvh_tri_result *out) {
+    int bad = 0;
+    for (int a = 0; a < 3; a++)
+        bad |= cbvh_f32_is_nan_or_inf(ray->o[a]) | cbvh_f32_is_nan_or_inf(ray->d[a]) |
+               cbvh_f32_is_nan_or_inf(v0[a]) | cbvh_f32_is_nan_or_inf(v1[a]) | cbvh_f32_is_nan_or_inf(v2[a]);
+    if (!bad && !(cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2])) &&
+        filter_miss(ray, v0, v1, v2)) {
+        memset(out, 0, sizeof *out);
+        return 0;
+    }
+    return cbvh_ray_triangle_exact_only(ray, v0, v1, v2, out);
+}
+
+int cbvh_ray_triangle_filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
+                                  const cbvh_f32 v2[3]) {
+    return filter_miss(ray, v0, v1, v2);
 }

@@ -14,10 +14,8 @@ static int box(trav_state *ts, const cbvh_bvh_node *n, cbvh_box_result *r) {
         lo[a] = bits(n->lo[a]);
         hi[a] = bits(n->hi[a]);
     }
-    cbvh_ray cull = *ts->ray;
-    cull.tmax = trav_box_tmax(ts);
     ts->s.box_tests++;
-    return cbvh_ray_box_float(&cull, ts->M, lo, hi, r) == 0 && r->hit;
+    return cbvh_ray_box_float_prep(&ts->prep, trav_box_tmax(ts), ts->M, lo, hi, r) == 0 && r->hit;
 }
 
 int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits, cbvh_trav_mode mode,
@@ -25,7 +23,7 @@ int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray,
     trav_state ts;
     memset(&ts, 0, sizeof ts);
     memset(hit, 0, sizeof *hit);
-    if (!trav_ray_ok(ray, mant_bits)) return -1;
+    if (!trav_ray_ok(&ts, ray, mant_bits)) return -1;
     ts.ray = ray;
     ts.tris = tris;
     ts.mode = mode;

@@ -24,7 +24,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     trav_state ts;
     memset(&ts, 0, sizeof ts);
     memset(hit, 0, sizeof *hit);
-    if (!trav_ray_ok(ray, mant_bits)) return -1;
+    if (!trav_ray_ok(&ts, ray, mant_bits)) return -1;
     ts.ray = ray;
     ts.tris = tris;
     ts.mode = mode;
@@ -35,10 +35,8 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;
     cbvh_box_result r;
-    cbvh_ray cull = *ray;
-    cull.tmax = trav_box_tmax(&ts);
     ts.s.box_tests++;
-    if (cbvh_ray_box_float(&cull, mant_bits, t->root_lo, t->root_hi, &r) == 0 && r.hit) {
+    if (cbvh_ray_box_float_prep(&ts.prep, trav_box_tmax(&ts), mant_bits, t->root_lo, t->root_hi, &r) == 0 && r.hit) {
         stack[0].leaf = 0;
         stack[0].ptr = t->root_pair;
         stack[0].ctx = t->root_ctx;
@@ -66,7 +64,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
             return -1;
         cbvh_box_result cr[2];
         int h[2] = {0, 0};
-        cull.tmax = trav_box_tmax(&ts);
+        cbvh_f32 cull_tmax = trav_box_tmax(&ts);
         for (int c = 0; c < 2; c++) {
             if (ch[c].empty) continue;
             cbvh_grid_axis g[3];
@@ -76,7 +74,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                 rel_coords(&t->params, &e.ctx.axis[a], &ch[c].axis[a], &g[a].r, &g[a].s);
             }
             ts.s.box_tests++;
-            h[c] = cbvh_ray_box(&cull, mant_bits, g, &cr[c]) == 0 && cr[c].hit;
+            h[c] = cbvh_ray_box_prep(&ts.prep, cull_tmax, mant_bits, g, &cr[c]) == 0 && cr[c].hit;
         }
         int first = (h[0] && h[1] && cbvh_f32_key(cr[1].t_near) < cbvh_f32_key(cr[0].t_near)) ? 1 : 0;
         for (int k = 1; k >= 0; k--) {

@@ -5,12 +5,14 @@
 #include <string.h>
 
 #include "cbvh/traverse.h"
+#include "ray_prep.h"
 
 /* Memory image used for the byte counters: node pairs from address 0, then
  * the primitive-ID array, then the triangles (36 bytes each), each region
  * starting on a line. */
 typedef struct {
     const cbvh_ray *ray;
+    cbvh_rb_ray prep; /* the ray prepared once for the box unit's fast path */
     const cbvh_tri *tris;
     cbvh_trav_mode mode;
     int M;
@@ -59,10 +61,11 @@ static inline void trav_triangle(trav_state *ts, uint32_t id) {
 }
 
 /* A ray the units reject (NaN/Inf, zero direction) is an error for the traversal. */
-static inline int trav_ray_ok(const cbvh_ray *ray, int M) {
+static inline int trav_ray_ok(trav_state *ts, const cbvh_ray *ray, int M) {
     cbvh_f32 lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     cbvh_box_result r;
-    return cbvh_ray_box_float(ray, M, lo, hi, &r) == 0;
+    cbvh_rb_prepare(ray, &ts->prep);
+    return cbvh_ray_box_float_prep(&ts->prep, ray->tmax, M, lo, hi, &r) == 0;
 }
 
 static inline void trav_finish(const trav_state *ts, cbvh_trav_hit *hit, cbvh_trav_stats *st) {

@@ -1,0 +1,292 @@
+/* Traversal benchmark (issue 4, "Performance"): on the same scene and the same
+ * rays in one run, single-ray throughput of
+ *   - Embree 3 rtcIntersect1 / rtcOccluded1 (the baseline; if built with it),
+ *   - the float-BVH reference traversal (bit-exact units, M = 24),
+ *   - the bit-exact CBVH traversal (N = 6 modulo, M = 24),
+ * closest hit and any hit, one core, as ratios to Embree.
+ *
+ * usage: bench_traverse [--rays R] [--seed S] [--reps K] [SCENE...]
+ *   SCENE as for `cbvh study` (mesh file or proc:NAME[:SIZE]); default: the
+ *   bundled bunny.  R rays per kind (default 20000): camera rays (pinhole, a
+ *   square image looking at the scene centre from outside its box) and random
+ *   rays (origin uniform in the scene box, direction uniform on the sphere),
+ *   seeded.  Times are the best of K repetitions (default 3), the tracers
+ *   interleaved within each repetition.
+ * Embree's device is created with threads=1; the traversal loop runs on the
+ * calling thread for every tracer. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cbvh/bvh.h"
+#include "cbvh/cbvh_tree.h"
+#include "cbvh/traverse.h"
+#include "scene_load.h"
+
+#ifdef CBVH_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+#ifndef CBVH_SCENES_DIR
+#define CBVH_SCENES_DIR "scenes"
+#endif
+
+static double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void die(const char *what, const char *err) {
+    fprintf(stderr, "bench_traverse: %s: %s\n", what, err);
+    exit(1);
+}
+
+static uint64_t rs;
+static uint64_t rnd(void) {
+    rs ^= rs << 13;
+    rs ^= rs >> 7;
+    rs ^= rs << 17;
+    return rs;
+}
+static float unit(void) { return (float)((double)(rnd() >> 11) / 9007199254740992.0); }
+static cbvh_f32 fb(float f) {
+    cbvh_f32 b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+static float bf(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+/* Camera rays over a square image (first half) and random rays (second half). */
+static void make_rays(const float lo[3], const float hi[3], int n, cbvh_ray *rays) {
+    float c[3], ext = 0;
+    for (int a = 0; a < 3; a++) {
+        c[a] = 0.5f * (lo[a] + hi[a]);
+        if (hi[a] - lo[a] > ext) ext = hi[a] - lo[a];
+    }
+    if (ext <= 0) ext = 1;
+    int ncam = n / 2, side = (int)ceil(sqrt((double)ncam));
+    float eye[3] = {c[0] + 0.3f * ext, c[1] + 0.4f * ext, c[2] + 1.6f * ext};
+    float w[3], len = 0; /* forward, then right/up from the y axis */
+    for (int a = 0; a < 3; a++) w[a] = c[a] - eye[a], len += w[a] * w[a];
+    len = sqrtf(len);
+    for (int a = 0; a < 3; a++) w[a] /= len;
+    float u[3] = {w[2], 0, -w[0]}, ul = sqrtf(u[0] * u[0] + u[2] * u[2]);
+    for (int a = 0; a < 3; a++) u[a] /= ul;
+    float v[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    for (int i = 0; i < n; i++) {
+        cbvh_ray *r = &rays[i];
+        float d[3], o[3];
+        if (i < ncam) {
+            float px = ((float)(i % side) + 0.5f) / (float)side * 2 - 1;
+            float py = ((float)(i / side) + 0.5f) / (float)side * 2 - 1;
+            for (int a = 0; a < 3; a++) {
+                o[a] = eye[a];
+                d[a] = w[a] + 0.45f * (px * u[a] + py * v[a]);
+            }
+        } else {
+            float z = unit() * 2 - 1, phi = 6.2831853f * unit(), s = sqrtf(fmaxf(0, 1 - z * z));
+            d[0] = s * cosf(phi);
+            d[1] = s * sinf(phi);
+            d[2] = z;
+            for (int a = 0; a < 3; a++) o[a] = lo[a] + unit() * (hi[a] - lo[a]);
+            if (d[0] == 0 && d[1] == 0 && d[2] == 0) d[0] = 1;
+        }
+        for (int a = 0; a < 3; a++) {
+            r->o[a] = fb(o[a]);
+            r->d[a] = fb(d[a]);
+        }
+        r->tmin = 0;
+        r->tmax = CBVH_F32_POS_INF;
+    }
+}
+
+typedef struct {
+    double rays_per_s;
+    long hits;
+} result;
+
+static result run_ours(int cbvh, const cbvh_bvh *b, const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *rays,
+                       int n, cbvh_trav_mode mode, int reps, cbvh_trav_stats *st) {
+    result res = {0, 0};
+    double best = 1e30;
+    for (int k = 0; k < reps; k++) {
+        long hits = 0;
+        cbvh_trav_stats s = {0};
+        double t0 = now();
+        for (int i = 0; i < n; i++) {
+            cbvh_trav_hit h;
+            int rc = cbvh ? cbvh_trace_cbvh(t, tris, &rays[i], 24, mode, &h, &s)
+                          : cbvh_trace_bvh(b, tris, &rays[i], 24, mode, &h, &s);
+            if (rc) die("trace", "ray rejected");
+            hits += h.hit;
+        }
+        double dt = now() - t0;
+        if (dt < best) best = dt;
+        res.hits = hits;
+        *st = s;
+    }
+    res.rays_per_s = n / best;
+    return res;
+}
+
+#ifdef CBVH_HAVE_EMBREE
+static result run_embree(RTCScene sc, const cbvh_ray *rays, int n, int occluded, int reps) {
+    result res = {0, 0};
+    double best = 1e30;
+    for (int k = 0; k < reps; k++) {
+        long hits = 0;
+        double t0 = now();
+        for (int i = 0; i < n; i++) {
+            struct RTCIntersectContext ctx;
+            rtcInitIntersectContext(&ctx);
+            struct RTCRayHit rh;
+            rh.ray.org_x = bf(rays[i].o[0]);
+            rh.ray.org_y = bf(rays[i].o[1]);
+            rh.ray.org_z = bf(rays[i].o[2]);
+            rh.ray.dir_x = bf(rays[i].d[0]);
+            rh.ray.dir_y = bf(rays[i].d[1]);
+            rh.ray.dir_z = bf(rays[i].d[2]);
+            rh.ray.tnear = 0;
+            rh.ray.tfar = INFINITY;
+            rh.ray.time = 0;
+            rh.ray.mask = 0xFFFFFFFFu;
+            rh.ray.id = 0;
+            rh.ray.flags = 0;
+            if (occluded) {
+                rtcOccluded1(sc, &ctx, &rh.ray);
+                hits += rh.ray.tfar < 0;
+            } else {
+                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                rtcIntersect1(sc, &ctx, &rh);
+                hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+            }
+        }
+        double dt = now() - t0;
+        if (dt < best) best = dt;
+        res.hits = hits;
+    }
+    res.rays_per_s = n / best;
+    return res;
+}
+
+static RTCScene embree_scene(RTCDevice dev, const cbvh_scene *s) {
+    RTCScene sc = rtcNewScene(dev);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                        (size_t)s->ntris * 3);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                           s->ntris);
+    if (!vb || !ib) die("embree", "buffer allocation failed");
+    for (uint32_t i = 0; i < s->ntris; i++)
+        for (int k = 0; k < 3; k++) {
+            for (int a = 0; a < 3; a++) vb[(size_t)9 * i + 3 * k + a] = s->tris[i].v[k][a];
+            ib[(size_t)3 * i + k] = 3 * i + (unsigned)k;
+        }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(sc, g);
+    rtcReleaseGeometry(g);
+    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(sc);
+    return sc;
+}
+#endif
+
+int main(int argc, char **argv) {
+    int nrays = 20000, reps = 3;
+    uint64_t seed = 1;
+    const char *specs[64];
+    int ns = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
+            nrays = atoi(argv[++i]);
+            if (nrays < 2 || nrays > 10000000) die("--rays", "must be 2..10000000");
+        } else if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
+            reps = atoi(argv[++i]);
+            if (reps < 1 || reps > 100) die("--reps", "must be 1..100");
+        } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
+            seed = strtoull(argv[++i], NULL, 0);
+        } else if (argv[i][0] == '-') {
+            fprintf(stderr, "usage: bench_traverse [--rays R] [--seed S] [--reps K] [SCENE...]\n");
+            return 2;
+        } else if (ns < 64) {
+            specs[ns++] = argv[i];
+        }
+    }
+    if (!ns) specs[ns++] = CBVH_SCENES_DIR "/bunny-small.obj";
+    rs = seed * 0x9E3779B97F4A7C15u + 0x2545F4914F6CDD1Du;
+    if (!rs) rs = 1;
+#ifdef CBVH_HAVE_EMBREE
+    RTCDevice dev = rtcNewDevice("threads=1");
+    if (!dev) die("embree", "rtcNewDevice failed");
+#else
+    printf("(built without Embree: no baseline, absolute rays/s only)\n");
+#endif
+    char err[512];
+    printf("%-28s %8s %-8s %12s %12s %12s %12s %12s %8s %8s %8s\n", "scene", "tris", "kind", "embree_r/s",
+           "bvh_r/s", "cbvh_r/s", "bvh/emb", "cbvh/emb", "hits_e", "hits_b", "hits_c");
+    cbvh_ray *rays = malloc((size_t)nrays * sizeof *rays);
+    if (!rays) die("rays", "out of memory");
+    for (int si = 0; si < ns; si++) {
+        cbvh_scene s;
+        if (cbvh_scene_open(specs[si], &s, err, sizeof err)) die(specs[si], err);
+        cbvh_bvh b;
+        if (cbvh_build_sah(&s, 0, 0, &b, err, sizeof err)) die("build", err);
+        cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 1, 0};
+        cbvh_tree t;
+        if (cbvh_compress_topdown(&b, &o, &t, err, sizeof err)) die("compress", err);
+        float lo[3], hi[3];
+        cbvh_scene_bounds(&s, lo, hi);
+        make_rays(lo, hi, nrays, rays);
+#ifdef CBVH_HAVE_EMBREE
+        RTCScene sc = embree_scene(dev, &s);
+#endif
+        const char *base = strrchr(specs[si], '/') ? strrchr(specs[si], '/') + 1 : specs[si];
+        for (int half = 0; half < 2; half++) {
+            const cbvh_ray *rr = rays + (half ? nrays / 2 : 0);
+            int n = half ? nrays - nrays / 2 : nrays / 2;
+            for (int mode = 0; mode < 2; mode++) {
+                /* repetitions interleave the three tracers so that load changes on
+                 * the shared machine hit all of them alike; best time of each */
+                cbvh_trav_stats sb, sc_;
+                result rb = {0, 0}, rc = {0, 0}, re = {0, 0};
+                for (int k = 0; k < reps; k++) {
+                    result x = run_ours(0, &b, &t, s.tris, rr, n, (cbvh_trav_mode)mode, 1, &sb);
+                    if (x.rays_per_s > rb.rays_per_s) rb = x;
+                    x = run_ours(1, &b, &t, s.tris, rr, n, (cbvh_trav_mode)mode, 1, &sc_);
+                    if (x.rays_per_s > rc.rays_per_s) rc = x;
+#ifdef CBVH_HAVE_EMBREE
+                    x = run_embree(sc, rr, n, mode, 1);
+                    if (x.rays_per_s > re.rays_per_s) re = x;
+#endif
+                }
+                char kind[16];
+                snprintf(kind, sizeof kind, "%s-%s", half ? "rand" : "cam", mode ? "any" : "closest");
+                printf("%-28s %8u %-8s %12.0f %12.0f %12.0f %12.4f %12.4f %8ld %8ld %8ld\n", base, s.ntris, kind,
+                       re.rays_per_s, rb.rays_per_s, rc.rays_per_s,
+                       re.rays_per_s > 0 ? rb.rays_per_s / re.rays_per_s : 0,
+                       re.rays_per_s > 0 ? rc.rays_per_s / re.rays_per_s : 0, re.hits, rb.hits, rc.hits);
+                fflush(stdout);
+            }
+        }
+#ifdef CBVH_HAVE_EMBREE
+        rtcReleaseScene(sc);
+#endif
+        cbvh_tree_free(&t);
+        cbvh_bvh_free(&b);
+        cbvh_scene_free(&s);
+    }
+    free(rays);
+#ifdef CBVH_HAVE_EMBREE
+    rtcReleaseDevice(dev);
+#endif
+    return 0;
+}

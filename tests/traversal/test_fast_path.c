@@ -1,0 +1,274 @@
+/* The traversal units' fast paths against their exact paths
+ * (docs/traversal.md, "Performance filter"):
+ *   - ray-box (grid planes and float planes): whenever the integer fast path
+ *     decides, its outputs equal the exact path's bit for bit; the public unit
+ *     (fast path + fallback) equals the exact path always;
+ *   - ray-triangle: whenever the binary64 miss filter claims a miss, the
+ *     exact path misses; the public unit equals the exact path always;
+ *   - and the fast paths actually decide most random cases (so the speed-up
+ *     is real and the comparison above is not vacuous).
+ * Inputs: random values over wide exponent ranges plus the hard cases -
+ * origins on planes, +-0 and subnormal direction components, power-of-two
+ * directions, exact quotients that land on the M-bit grid, -Inf context
+ * bounds, far-from-origin boxes, rays through triangle vertices and edges,
+ * rays in the triangle's plane, degenerate triangles. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../rtl-model/src/ray_prep.h"
+#include "cbvh/traversal_units.h"
+
+#ifdef CBVH_SANITIZE
+#define NBOX 400000
+#define NTRI 200000
+#else
+#define NBOX 2000000
+#define NTRI 1000000
+#endif
+
+static long failures;
+static uint64_t rs = 0x9E3779B97F4A7C15u;
+static uint64_t rnd(void) {
+    rs ^= rs << 13;
+    rs ^= rs >> 7;
+    rs ^= rs << 17;
+    return rs;
+}
+static uint32_t below(uint32_t n) { return (uint32_t)(rnd() % n); }
+
+/* 1 for a quarter of the inputs: scene-like values (no specials, exponents
+ * within +-3 of each other, grid steps down to 2^-20 of the context bound,
+ * valid boxes), where the fast paths must decide nearly always. */
+static int typical;
+
+/* A finite binary32 pattern with exponent in [emid - spread, emid + spread]
+ * (clamped to the finite range), sometimes special. */
+static cbvh_f32 rf(int emid, int spread) {
+    uint32_t k = typical ? 9 + below(23) : below(32); /* typical: full random fractions */
+    cbvh_f32 sign = (rnd() & 1) ? CBVH_F32_SIGN : 0;
+    if (k == 0) return sign;                                     /* +-0 */
+    if (k == 1) return sign | (uint32_t)(1 + below(0x7FFFFF));   /* subnormal */
+    if (k == 2) return sign | CBVH_F32_MAX;                       /* +-FLT_MAX */
+    int e = emid - spread + (int)below((uint32_t)(2 * spread + 1));
+    if (e < -126) e = -126;
+    if (e > 127) e = 127;
+    uint32_t frac = (k < 6) ? 0 : (k < 9) ? (below(8) << 20) : (uint32_t)(rnd() & CBVH_F32_FRAC); /* 2^e, few bits, any */
+    return sign | ((uint32_t)(e + 127) << 23) | frac;
+}
+
+static int small_exp(void) { return (int)below(21) - 10; }
+
+static int same_box(const cbvh_box_result *a, const cbvh_box_result *b) {
+    return a->hit == b->hit && a->t_near == b->t_near && a->t_far == b->t_far;
+}
+
+static cbvh_ray random_ray(int emid, int spread) {
+    cbvh_ray r;
+    for (int a = 0; a < 3; a++) {
+        r.o[a] = rf(emid, spread);
+        if (typical) {
+            r.d[a] = rf(0, 3);
+            continue;
+        }
+        r.d[a] = below(6) == 0 ? ((rnd() & 1) ? CBVH_F32_SIGN : 0) : rf(small_exp(), 12);
+        if (below(8) == 0) r.d[a] = (rnd() & 1 ? CBVH_F32_SIGN : 0) | ((uint32_t)(127 + small_exp()) << 23); /* 2^k */
+        if (below(10) == 0) r.d[a] = (rnd() & 1 ? CBVH_F32_SIGN : 0) | ((uint32_t)(127 + small_exp()) << 23) | 0x400000u; /* 3*2^k */
+    }
+    if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[below(3)] = 0x3F800000u;
+    r.tmin = below(4) ? 0 : rf(emid, spread);
+    uint32_t k = below(4);
+    r.tmax = k == 0 ? rf(emid + 2, spread) : CBVH_F32_POS_INF;
+    if (k == 1) r.tmax = CBVH_F32_MAX;
+    return r;
+}
+
+static long typ_total, typ_decided;
+
+static void box_cases(long *decided, long *total) {
+    for (long i = 0; i < NBOX; i++) {
+        typical = (i & 3) == 0;
+        int emid = below(16) == 0 ? (int)below(200) - 100 : small_exp();
+        int spread = below(4) == 0 ? 40 : 3;
+        if (typical) spread = 3;
+        cbvh_ray ray = random_ray(emid, spread);
+        int M = CBVH_MANT_MIN + (int)below(CBVH_MANT_MAX - CBVH_MANT_MIN + 1);
+        cbvh_grid_axis g[3];
+        for (int a = 0; a < 3; a++) {
+            g[a].u = below(64) == 0 && !typical ? CBVH_F32_NEG_INF : rf(emid, spread);
+            int eu = (int)((g[a].u >> 23) & 0xFF) - 127;
+            g[a].e = typical ? eu - 20 + (int)below(24) : eu - 30 + (int)below(34);
+            if (below(16) == 0 && !typical) g[a].e = (int)below(253) - 126;
+            if (g[a].e < CBVH_SCALE_FLOOR) g[a].e = CBVH_SCALE_FLOOR;
+            if (g[a].e > CBVH_SCALE_CEIL) g[a].e = CBVH_SCALE_CEIL;
+            g[a].r = below(1024);
+            g[a].s = g[a].r + 1 + below(1024 - g[a].r);
+            uint32_t hard = typical ? 7 : below(8);
+            if (hard == 0 && g[a].u != CBVH_F32_NEG_INF) { /* origin exactly on the lower plane */
+                g[a].r = 0;
+                ray.o[a] = g[a].u;
+            } else if (hard == 1) { /* exact quotient on the grid: (L - o) = 3 * 2^e, d = 3 * 2^k */
+                g[a].u = 0;
+                ray.o[a] = 0;
+                g[a].r = 3;
+                g[a].s = 3 + below(1000);
+                ray.d[a] = ((uint32_t)(127 + small_exp()) << 23) | 0x400000u | (rnd() & 1 ? CBVH_F32_SIGN : 0);
+            }
+        }
+        if (below(32) == 0 && !typical) g[below(3)].s = g[0].r; /* sometimes an invalid box: status must match too */
+        cbvh_box_result fe, ff, fu;
+        uint32_t se = cbvh_ray_box_exact_only(&ray, M, g, &fe);
+        uint32_t su = cbvh_ray_box(&ray, M, g, &fu);
+        int fr = cbvh_ray_box_fast_only(&ray, M, g, &ff);
+        (*total)++;
+        if (typical) {
+            typ_total++;
+            typ_decided += fr == 0;
+        }
+        if (se != su || !same_box(&fe, &fu)) {
+            if (failures++ < 10)
+                fprintf(stderr, "FAIL box %ld M=%d: unit st %X hit %d %08X %08X, exact st %X hit %d %08X %08X\n", i, M,
+                        su, fu.hit, fu.t_near, fu.t_far, se, fe.hit, fe.t_near, fe.t_far);
+        }
+        if (fr == 0) {
+            (*decided)++;
+            if (se != 0 || !same_box(&fe, &ff)) {
+                if (failures++ < 10)
+                    fprintf(stderr, "FAIL box fast %ld M=%d: fast hit %d %08X %08X, exact st %X hit %d %08X %08X\n", i,
+                            M, ff.hit, ff.t_near, ff.t_far, se, fe.hit, fe.t_near, fe.t_far);
+            }
+        }
+    }
+}
+
+static void float_box_cases(long *decided, long *total) {
+    for (long i = 0; i < NBOX / 2; i++) {
+        typical = (i & 3) == 0;
+        int emid = below(16) == 0 ? (int)below(200) - 100 : small_exp();
+        int spread = below(4) == 0 ? 40 : 3;
+        if (typical) spread = 3;
+        cbvh_ray ray = random_ray(emid, spread);
+        int M = below(2) ? 24 : CBVH_MANT_MIN + (int)below(CBVH_MANT_MAX - CBVH_MANT_MIN + 1);
+        cbvh_f32 lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = rf(emid, spread);
+            hi[a] = rf(emid, spread);
+            if (cbvh_f32_cmp(lo[a], hi[a]) > 0 && (typical || below(16))) {
+                cbvh_f32 t = lo[a];
+                lo[a] = hi[a];
+                hi[a] = t;
+            }
+            uint32_t hard = typical ? 7 : below(8);
+            if (hard == 0) ray.o[a] = lo[a];          /* on a face */
+            else if (hard == 1) ray.o[a] = hi[a];
+            else if (hard == 2) hi[a] = lo[a];        /* flat box */
+        }
+        cbvh_box_result fe, ff, fu;
+        uint32_t se = cbvh_ray_box_float_exact_only(&ray, M, lo, hi, &fe);
+        uint32_t su = cbvh_ray_box_float(&ray, M, lo, hi, &fu);
+        int fr = cbvh_ray_box_float_fast_only(&ray, M, lo, hi, &ff);
+        (*total)++;
+        if (typical) {
+            typ_total++;
+            typ_decided += fr == 0;
+        }
+        if (se != su || !same_box(&fe, &fu)) {
+            if (failures++ < 10) fprintf(stderr, "FAIL float box %ld M=%d: unit != exact\n", i, M);
+        }
+        if (fr == 0) {
+            (*decided)++;
+            if (se != 0 || !same_box(&fe, &ff)) {
+                if (failures++ < 10) fprintf(stderr, "FAIL float box fast %ld M=%d: fast != exact\n", i, M);
+            }
+        }
+    }
+}
+
+static long typ_tri_miss, typ_tri_decided;
+
+static void tri_cases(long *decided, long *total, long *exact_hits) {
+    for (long i = 0; i < NTRI; i++) {
+        typical = (i & 3) == 0;
+        int emid = below(16) == 0 ? (int)below(200) - 100 : small_exp();
+        int spread = below(4) == 0 && !typical ? 30 : 2;
+        cbvh_ray ray = random_ray(emid, spread);
+        cbvh_f32 v[3][3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++) v[k][a] = rf(emid, spread);
+        uint32_t hard = typical ? 7 : below(8);
+        if (hard == 0) { /* through a vertex: d = v0 - o when exact */
+            float o[3], p[3];
+            for (int a = 0; a < 3; a++) {
+                memcpy(&o[a], &ray.o[a], 4);
+                memcpy(&p[a], &v[0][a], 4);
+                float dd = p[a] - o[a];
+                memcpy(&ray.d[a], &dd, 4);
+            }
+        } else if (hard == 1) { /* through the midpoint of an edge (often exact) */
+            for (int a = 0; a < 3; a++) {
+                float p0, p1, o;
+                memcpy(&p0, &v[0][a], 4);
+                memcpy(&p1, &v[1][a], 4);
+                memcpy(&o, &ray.o[a], 4);
+                float dd = 0.5f * p0 + 0.5f * p1 - o;
+                memcpy(&ray.d[a], &dd, 4);
+            }
+        } else if (hard == 2) { /* origin in the triangle's plane (a vertex) */
+            memcpy(ray.o, v[2], sizeof ray.o);
+        } else if (hard == 3) { /* degenerate: two equal vertices */
+            memcpy(v[1], v[0], sizeof v[0]);
+        } else if (hard == 4) { /* axis-parallel ray toward the triangle's box */
+            int a = (int)below(3);
+            for (int b = 0; b < 3; b++) ray.d[b] = (rnd() & 1) ? CBVH_F32_SIGN : 0;
+            ray.d[a] = (rnd() & 1) ? 0xBF800000u : 0x3F800000u;
+            for (int b = 0; b < 3; b++)
+                if (b != a) ray.o[b] = v[below(3)][b];
+        }
+        int bad = 0;
+        for (int a = 0; a < 3; a++)
+            bad |= cbvh_f32_is_nan_or_inf(ray.d[a]) | cbvh_f32_is_nan_or_inf(ray.o[a]);
+        if (bad || (cbvh_f32_is_zero(ray.d[0]) && cbvh_f32_is_zero(ray.d[1]) && cbvh_f32_is_zero(ray.d[2])))
+            ray.d[0] = 0x3F800000u;
+        cbvh_tri_result re, ru;
+        uint32_t se = cbvh_ray_triangle_exact_only(&ray, v[0], v[1], v[2], &re);
+        uint32_t su = cbvh_ray_triangle(&ray, v[0], v[1], v[2], &ru);
+        (*total)++;
+        *exact_hits += re.hit;
+        if (se != su || memcmp(&re, &ru, sizeof re)) {
+            if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: unit != exact\n", i);
+        }
+        int fm = cbvh_ray_triangle_filter_miss(&ray, v[0], v[1], v[2]);
+        if (typical && !re.hit) {
+            typ_tri_miss++;
+            typ_tri_decided += fm;
+        }
+        if (fm) {
+            (*decided)++;
+            if (se != 0 || re.hit) {
+                if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: filter claims a miss, exact path hits\n", i);
+            }
+        }
+    }
+}
+
+int main(void) {
+    long bd = 0, bt = 0, fd = 0, ft = 0, td = 0, tt = 0, th = 0;
+    box_cases(&bd, &bt);
+    float_box_cases(&fd, &ft);
+    tri_cases(&td, &tt, &th);
+    printf("ray_box grid: %ld inputs, fast path decided %ld (%.2f%%)\n", bt, bd, 100.0 * (double)bd / (double)bt);
+    printf("ray_box float: %ld inputs, fast path decided %ld (%.2f%%)\n", ft, fd, 100.0 * (double)fd / (double)ft);
+    printf("ray_triangle: %ld inputs (%ld exact hits), filter proved %ld misses (%.2f%% of the %ld misses)\n", tt, th,
+           td, 100.0 * (double)td / (double)(tt - th), tt - th);
+    printf("scene-like inputs: box fast path decided %.3f%% of %ld, triangle filter proved %.3f%% of %ld misses\n",
+           100.0 * (double)typ_decided / (double)typ_total, typ_total,
+           100.0 * (double)typ_tri_decided / (double)typ_tri_miss, typ_tri_miss);
+    /* the fast paths must carry the bulk of the work, or the speed-up is fake */
+    if (typ_decided < typ_total * 99 / 100 || typ_tri_decided < typ_tri_miss * 9 / 10 || bd == 0 || fd == 0 ||
+        td == 0) {
+        fprintf(stderr, "FAIL: fast paths decide too few cases\n");
+        failures++;
+    }
+    if (failures) fprintf(stderr, "%ld failures\n", failures);
+    return failures ? 1 : 0;
+}
