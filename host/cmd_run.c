@@ -1,28 +1,24 @@
 /* `cbvh run`: the kit's main job.
  *   1. check the golden vectors on the board, or on the model without one;
- *   2. on the bundled scene, what each coordinate width N costs and buys:
- *      CBVH memory and tree quality (SAH cost of the decoded boxes) against the
- *      float BVH, and the time of the top-down compression that produces it. */
+ *   2. on the bundled scene file, what each coordinate width N costs: trace the
+ *      rays the scene's effects call for through the float BVH and through the
+ *      bit-exact CBVH at N = 3..10, and report memory, traversal work, the timing
+ *      model's time and CPU time relative to the float BVH, with a proof that
+ *      every CBVH gives exactly the float BVH's hits. */
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cjson/cJSON.h>
 
-#include "cbvh/bvh.h"
-#include "cbvh/cbvh_tree.h"
 #include "commands.h"
-#include "scene_load.h"
+#include "effects.h"
+#include "scene_file.h"
+#include "timing_model.h"
 #include "vectors_check.h"
-
-static double now_seconds(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* A bundled resource: relative to the working directory, else to the source tree. */
 static const char *bundled(const char *rel, char *buf, size_t len) {
@@ -33,51 +29,73 @@ static const char *bundled(const char *rel, char *buf, size_t len) {
 
 static void usage(FILE *f) {
     fprintf(f,
-            "usage: cbvh run [--backend SPEC] [--vectors DIR] [--scene PATH] [--json]\n"
+            "usage: cbvh run [--backend SPEC] [--vectors DIR] [--scene FILE.scene] [--json]\n"
             "\n"
             "The main job: checks the golden vectors (on a board if one is attached, else on\n"
-            "the bit-exact model), then prints an accuracy-vs-time table for a scene: per\n"
-            "coordinate width N, the CBVH's memory and SAH cost against the float BVH and the\n"
-            "time to compress it.\n"
+            "the bit-exact model), then traces the effects of a scene file through the float\n"
+            "BVH and the bit-exact CBVH at N = 3..10 and prints what each width costs: node\n"
+            "memory, box and triangle tests, bytes, modelled and CPU time per ray, relative to\n"
+            "the float BVH, and whether the hits are identical.\n"
             "\n"
             "  --backend SPEC  auto (default), model, usb, hid, sim:ADDR\n"
             "  --vectors DIR   vector directory (default: the committed vectors/)\n"
-            "  --scene PATH    mesh file or proc:NAME (default: scenes/bunny-small.obj)\n"
+            "  --scene FILE    scene file (default: scenes/bunny.scene; format: docs/scenes.md)\n"
             "  --json          one JSON object instead of tables\n");
 }
 
 typedef struct {
-    int bits;
-    size_t bytes;
-    double sah, seconds;
+    int bits; /* 0 = float BVH */
+    uint64_t node_bytes, rays, hit_digest;
+    double box, tri, bytes, model_ns, cpu_us; /* per ray, all effects */
 } width_row;
 
-/* Best of `reps` top-down compressions at width n, checked against the float BVH. */
-static int measure_width(const cbvh_bvh *bvh, int n, int reps, width_row *row, char *err, size_t errlen) {
-    cbvh_compress_opts o;
+static void timing_params(const cbvh_scene_desc *d, cbvh_timing_params *tp) {
+    cbvh_timing_defaults(tp);
+    const cbvh_timing_overrides *o = &d->timing;
+    if (!isnan(o->box_cycles)) tp->box_cycles = o->box_cycles;
+    if (!isnan(o->tri_cycles)) tp->tri_cycles = o->tri_cycles;
+    if (!isnan(o->fetch_latency)) tp->fetch_latency = o->fetch_latency;
+    if (!isnan(o->dram_bytes_per_cycle)) tp->dram_bytes_per_cycle = o->dram_bytes_per_cycle;
+    if (!isnan(o->clock_mhz)) tp->clock_mhz = o->clock_mhz;
+}
+
+/* Traces the scene in one format and sums the per-effect counters. */
+static int measure(const cbvh_scene_desc *d, const cbvh_timing_params *tp, int bits, width_row *row, char *err,
+                   size_t errlen) {
+    cbvh_fx_opts o;
     memset(&o, 0, sizeof o);
-    o.params.quant_bits = n;
+    o.format = bits ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT;
+    o.params.quant_bits = bits ? bits : 6;
     o.params.min_scale = CBVH_MIN_SCALE_DEFAULT;
-    o.enc = CBVH_ENC_MODULO;
-    o.treelet_depth = 1;
-    row->bits = n;
-    row->seconds = 1e30;
-    for (int r = 0; r < reps; r++) {
-        cbvh_tree t;
-        double t0 = now_seconds();
-        if (cbvh_compress_topdown(bvh, &o, &t, err, errlen) != 0) return -1;
-        double dt = now_seconds() - t0;
-        if (dt < row->seconds) row->seconds = dt;
-        if (r == 0) {
-            if (cbvh_tree_check(&t, bvh, err, errlen) != 0) {
-                cbvh_tree_free(&t);
-                return -1;
-            }
-            row->bytes = cbvh_tree_bytes(&t);
-            row->sah = cbvh_tree_sah(&t);
-        }
-        cbvh_tree_free(&t);
+    o.mant = 24;
+    cbvh_fx_result r;
+    if (cbvh_fx_run(d, &o, &r, err, errlen) != 0) return -1;
+    cbvh_timing_work w = {0, 0, 0, 0};
+    double cpu = 0;
+    memset(row, 0, sizeof *row);
+    row->bits = bits;
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        const cbvh_fx_stats *s = &r.fx[e];
+        row->rays += s->rays;
+        w.box_tests += s->st.box_tests;
+        w.tri_tests += s->st.tri_tests;
+        w.node_fetches += s->st.nodes;
+        w.bytes += s->st.bytes;
+        cpu += s->cpu_seconds;
     }
+    cbvh_timing_result tr;
+    if (cbvh_timing_eval(tp, &w, &tr) != 0 || row->rays == 0) {
+        snprintf(err, errlen, "scene traces no rays or has an invalid timing model");
+        return -1;
+    }
+    double n = (double)row->rays;
+    row->node_bytes = r.node_bytes;
+    row->hit_digest = r.hit_digest;
+    row->box = (double)w.box_tests / n;
+    row->tri = (double)w.tri_tests / n;
+    row->bytes = (double)w.bytes / n;
+    row->model_ns = tr.seconds * 1e9 / n;
+    row->cpu_us = cpu * 1e6 / n;
     return 0;
 }
 
@@ -107,7 +125,7 @@ int cmd_run(int argc, char **argv) {
         return 2;
     }
     if (!vec_dir) vec_dir = bundled("vectors", vbuf, sizeof vbuf);
-    if (!scene_path) scene_path = bundled("scenes/bunny-small.obj", sbuf, sizeof sbuf);
+    if (!scene_path) scene_path = bundled("scenes/bunny.scene", sbuf, sizeof sbuf);
 
     /* 1. Golden vectors. */
     cbvh_check_summary sum;
@@ -125,34 +143,25 @@ int cmd_run(int argc, char **argv) {
     if (check == CBVH_CHECK_BAD_INPUT) return 2;
 
     /* 2. Accuracy vs time on the scene. */
-    cbvh_scene scene;
-    memset(&scene, 0, sizeof scene);
-    if (cbvh_scene_open(scene_path, &scene, err, sizeof err) != 0) {
+    cbvh_scene_desc d;
+    if (cbvh_scene_file_load(scene_path, &d, err, sizeof err) != 0) {
         fprintf(stderr, "cbvh run: %s\n", err);
         return 2;
     }
-    cbvh_bvh bvh;
-    double t0 = now_seconds();
-    if (cbvh_build_sah(&scene, 0, 0, &bvh, err, sizeof err) != 0) {
-        fprintf(stderr, "cbvh run: %s: %s\n", scene_path, err);
-        cbvh_scene_free(&scene);
-        return 2;
-    }
-    double build_s = now_seconds() - t0;
-    double float_sah = cbvh_bvh_sah(&bvh);
-    size_t float_bytes = cbvh_bvh_bytes(&bvh);
-    uint32_t leaves, inner;
-    cbvh_bvh_counts(&bvh, &leaves, &inner);
-
-    width_row rows[CBVH_N_MAX - CBVH_N_MIN + 1];
-    int nrows = 0, rc = check;
-    for (int n = CBVH_N_MIN; n <= CBVH_N_MAX; n++, nrows++) {
-        if (measure_width(&bvh, n, 5, &rows[nrows], err, sizeof err) != 0) {
-            fprintf(stderr, "cbvh run: N=%d: %s\n", n, err);
-            rc = 1;
-            break;
+    cbvh_timing_params tp;
+    timing_params(&d, &tp);
+    width_row rows[1 + CBVH_N_MAX - CBVH_N_MIN + 1];
+    int nrows = 0, rc = check, same_hits = 1;
+    for (int n = 0; n <= CBVH_N_MAX; n = n ? n + 1 : CBVH_N_MIN, nrows++) {
+        if (measure(&d, &tp, n, &rows[nrows], err, sizeof err) != 0) {
+            fprintf(stderr, "cbvh run: %s: %s\n", scene_path, err);
+            cbvh_scene_desc_free(&d);
+            return 2;
         }
+        if (rows[nrows].hit_digest != rows[0].hit_digest) same_hits = 0;
     }
+    if (!same_hits) rc = 1;
+    const width_row *f = &rows[0];
 
     if (json) {
         cJSON *root = cJSON_CreateObject();
@@ -163,20 +172,21 @@ int cmd_run(int argc, char **argv) {
         cJSON_AddNumberToObject(v, "failed", (double)sum.failed);
         cJSON *s = cJSON_AddObjectToObject(root, "scene");
         cJSON_AddStringToObject(s, "path", scene_path);
-        cJSON_AddNumberToObject(s, "triangles", scene.ntris);
-        cJSON_AddNumberToObject(s, "float_bvh_bytes", (double)float_bytes);
-        cJSON_AddNumberToObject(s, "float_bvh_sah", float_sah);
-        cJSON_AddNumberToObject(s, "float_bvh_build_seconds", build_s);
-        cJSON *arr = cJSON_AddArrayToObject(root, "widths");
+        cJSON_AddNumberToObject(s, "triangles", d.mesh.ntris);
+        cJSON_AddNumberToObject(s, "rays", (double)f->rays);
+        cJSON_AddBoolToObject(s, "hits_identical_to_float", same_hits);
+        cJSON *arr = cJSON_AddArrayToObject(root, "formats");
         for (int i = 0; i < nrows; i++) {
+            const width_row *w = &rows[i];
             cJSON *r = cJSON_CreateObject();
-            cJSON_AddNumberToObject(r, "bits", rows[i].bits);
-            cJSON_AddNumberToObject(r, "bytes", (double)rows[i].bytes);
-            cJSON_AddNumberToObject(r, "memory_vs_float", (double)rows[i].bytes / (double)float_bytes);
-            cJSON_AddNumberToObject(r, "sah", rows[i].sah);
-            cJSON_AddNumberToObject(r, "sah_vs_float", rows[i].sah / float_sah);
-            cJSON_AddNumberToObject(r, "compress_seconds", rows[i].seconds);
-            cJSON_AddNumberToObject(r, "compress_vs_float_build", rows[i].seconds / build_s);
+            cJSON_AddStringToObject(r, "format", w->bits ? "cbvh" : "float");
+            if (w->bits) cJSON_AddNumberToObject(r, "bits", w->bits);
+            cJSON_AddNumberToObject(r, "node_bytes", (double)w->node_bytes);
+            cJSON_AddNumberToObject(r, "box_tests_per_ray", w->box);
+            cJSON_AddNumberToObject(r, "tri_tests_per_ray", w->tri);
+            cJSON_AddNumberToObject(r, "bytes_per_ray", w->bytes);
+            cJSON_AddNumberToObject(r, "model_ns_per_ray", w->model_ns);
+            cJSON_AddNumberToObject(r, "cpu_us_per_ray", w->cpu_us);
             cJSON_AddItemToArray(arr, r);
         }
         char *text = cJSON_Print(root);
@@ -184,20 +194,27 @@ int cmd_run(int argc, char **argv) {
         free(text);
         cJSON_Delete(root);
     } else {
-        printf("\n== Accuracy vs time: %s (%u triangles; float SAH BVH: %u inner nodes, %u leaves) ==\n",
-               scene_path, scene.ntris, inner, leaves);
-        printf("   N  pair B   memory/float   SAH cost/float   compress ns/node   compress/float build\n");
-        printf("  float  64      1.000          1.000            %8.1f (build)       1.00\n",
-               1e9 * build_s / (double)(inner ? inner : 1));
-        for (int i = 0; i < nrows; i++)
-            printf("  %3d  %4zu      %6.3f         %6.3f           %8.1f               %5.2f\n", rows[i].bits,
-                   cbvh_nodepair_bytes(rows[i].bits), (double)rows[i].bytes / (double)float_bytes,
-                   rows[i].sah / float_sah, 1e9 * rows[i].seconds / (double)(inner ? inner : 1),
-                   rows[i].seconds / build_s);
-        printf("\nEvery decoded CBVH box was checked to enclose its float box. SAH cost is the\n"
-               "expected traversal work (box + triangle tests) relative to the float BVH.\n");
+        printf("\n== Accuracy vs time: %s (%u triangles, %llu rays over its effects) ==\n", scene_path,
+               d.mesh.ntris, (unsigned long long)f->rays);
+        printf("  format  memory  box/ray  tri/ray  bytes/ray  model ns/ray  CPU us/ray   (x float: memory, box, tri, "
+               "bytes, model, CPU)\n");
+        for (int i = 0; i < nrows; i++) {
+            const width_row *w = &rows[i];
+            char name[16];
+            snprintf(name, sizeof name, w->bits ? "N=%d" : "float", w->bits);
+            printf("  %-6s %7llu  %7.2f  %7.2f  %9.0f  %12.1f  %10.2f", name, (unsigned long long)w->node_bytes,
+                   w->box, w->tri, w->bytes, w->model_ns, w->cpu_us);
+            if (w->bits)
+                printf("   x%.3f x%.3f x%.3f x%.3f x%.3f x%.2f", (double)w->node_bytes / (double)f->node_bytes,
+                       w->box / f->box, w->tri / f->tri, w->bytes / f->bytes, w->model_ns / f->model_ns,
+                       w->cpu_us / f->cpu_us);
+            printf("\n");
+        }
+        printf("\nHits %s the float BVH's for every width (closest hits: triangle and t bits;\n"
+               "any hits: hit or not). Model time: docs/timing_model.md; CPU time is the bit-exact\n"
+               "model's own speed on this machine. Per effect: cbvh trace %s --bits N.\n",
+               same_hits ? "are identical to" : "DIFFER from", scene_path);
     }
-    cbvh_bvh_free(&bvh);
-    cbvh_scene_free(&scene);
+    cbvh_scene_desc_free(&d);
     return rc;
 }

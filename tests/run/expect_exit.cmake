@@ -1,0 +1,9 @@
+# `cbvh run --scene <missing>` must exit 2 with one line naming the file.
+execute_process(COMMAND ${CBVH} run --backend model --scene /nonexistent/x.scene
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 2)
+    message(FATAL_ERROR "expected exit 2, got ${rc}: ${err}")
+endif()
+if(NOT err MATCHES "cbvh run: [^\n]*/nonexistent/x.scene[^\n]*\n$")
+    message(FATAL_ERROR "expected one line naming the scene file, got: ${err}")
+endif()
