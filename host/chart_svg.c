@@ -1,4 +1,5 @@
 /* SVG line charts (see chart_svg.h). */
+#include "file_mode.h"
 #include "chart_svg.h"
 
 #include <errno.h>
@@ -90,6 +91,7 @@ int cbvh_svg_chart(const char *path, const char *title, const char *xlabel, cons
         free(tmp);
         return -1;
     }
+    cbvh_fd_default_mode(fd);
     FILE *f = fdopen(fd, "w");
     if (!f) {
         snprintf(err, errlen, "svg: cannot open %s: %s", tmp, strerror(errno));

@@ -11,5 +11,6 @@ int cmd_devices(int argc, char **argv);   /* cmd_devices.c: boards per backend *
 int cmd_board_sim(int argc, char **argv); /* cmd_board_sim.c: the virtual board */
 int cmd_study(int argc, char **argv);     /* cmd_study.c: backtracking/memory-traffic study (issue 3) */
 int cmd_trace(int argc, char **argv);     /* cmd_trace.c: trace the effects a scene file calls for (issue 4) */
+int cmd_sweep(int argc, char **argv);     /* cmd_sweep.c: accuracy vs time over N x M x min scale (issue 4) */
 
 #endif

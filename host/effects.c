@@ -80,6 +80,7 @@ typedef struct {
     cbvh_tri *tris; /* current frame */
     float eps;      /* secondary-ray origin offset along the normal */
     int frame;
+    int px, py;     /* pixel being traced (for observers) */
 } tracer;
 
 static double cpu_now(void) {
@@ -130,7 +131,7 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
                  (!hit->hit ? 0xFFFFFFFFFFFFFFFFu : mode == CBVH_TRAV_ANY ? 1 : ((uint64_t)hit->prim << 32 | hit->t));
     T->res->hit_digest = mix64(h + (uint64_t)fx);
     if (T->o->on_ray) {
-        cbvh_fx_ray fr = {fx, mode, r, src, light, T->frame, hit};
+        cbvh_fx_ray fr = {fx, mode, r, src, light, T->frame, hit, &st, T->px, T->py};
         T->o->on_ray(T->o->ctx, &fr);
     }
     return hit->hit;
@@ -248,6 +249,8 @@ static void trace_frame(tracer *T) {
         if (T->o->progress) T->o->progress(T->o->ctx, T->frame, frames, y, c->height);
         for (int x = 0; x < c->width; x++)
             for (int s = 0; s < spp; s++) {
+                T->px = x;
+                T->py = y;
                 uint64_t pix = ((uint64_t)y * (uint64_t)c->width + (uint64_t)x) * (uint64_t)spp + (uint64_t)s;
                 rng R = {mix64(d->seed * 0x9E3779B97F4A7C15u ^ mix64(pix + ((uint64_t)T->frame << 40)))};
                 float o[3], dir[3];

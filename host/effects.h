@@ -23,6 +23,8 @@ typedef struct {
     int light;             /* shadow rays: the light aimed at; else -1 */
     int frame;
     const cbvh_trav_hit *hit;
+    const cbvh_trav_stats *st; /* this ray's own counters */
+    int px, py;                /* camera pixel whose path the ray belongs to */
 } cbvh_fx_ray;
 
 typedef struct {

@@ -1,4 +1,5 @@
 /* PNG writer and heat maps (see image_png.h). */
+#include "file_mode.h"
 #include "image_png.h"
 
 #include <errno.h>
@@ -40,6 +41,7 @@ static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned 
         free(tmp);
         return -1;
     }
+    cbvh_fd_default_mode(fd);
     FILE *f = fdopen(fd, "wb");
     if (!f) {
         snprintf(err, errlen, "png: cannot open %s: %s", tmp, strerror(errno));

@@ -17,6 +17,7 @@ static const command commands[] = {
     {"board-sim", cmd_board_sim, "run the virtual board (firmware sim port) on a socket"},
     {"study", cmd_study, "backtracking, memory-traffic and min-scale study of streaming CBVH builds"},
     {"trace", cmd_trace, "trace the rays a scene file's effects call for; cost per effect and timing model"},
+    {"sweep", cmd_sweep, "accuracy vs time: cost per precision setting vs the float BVH, same-hits proof, charts"},
 };
 
 static void usage(FILE *f) {

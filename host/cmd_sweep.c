@@ -1,0 +1,624 @@
+/* cbvh sweep SCENE: what each bit of precision costs (docs/sweep.md).  The
+ * float BVH and every CBVH setting trace the same rays in one run; costs are
+ * printed relative to the float BVH, a chart and heat maps go to --out, and
+ * every setting must return the float BVH's hits (exit 1 naming the first
+ * differing ray otherwise). */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "chart_svg.h"
+#include "commands.h"
+#include "image_png.h"
+#include "sweep.h"
+
+#define MAX_HEAT 16
+
+static void usage(FILE *f) {
+    fprintf(f,
+            "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
+            "                        [--out DIR] [--heatmap SETTING...] [--knee PCT]\n"
+            "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
+            "  setting N x M x E, on the same rays, and prints per setting and effect: box and triangle\n"
+            "  tests, bytes per ray, node memory, modelled time and CPU time, each relative to the float\n"
+            "  BVH; proves every setting returns the float BVH's hits and image (exit 1 if not); says\n"
+            "  where the knee is; writes a chart and heat maps (docs/sweep.md).\n"
+            "  --bits LO..HI     coordinate bits N, within %d..%d (default 3..10; N alone = one value)\n"
+            "  --mant M...       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
+            "  --min-scale E...  minimum grid scale, -126..126 (default %d)\n"
+            "  --spp K           camera samples per pixel, 1..1024 (default: the scene's)\n"
+            "  --out DIR         where the chart and heat maps go (default sweep-<scene name>)\n"
+            "  --heatmap S...    settings to draw box tests per pixel for: float, N, or N:M:E\n"
+            "                    (default float 3 6 10, those in range; N uses the first M and E)\n"
+            "  --knee PCT        knee tolerance in percent, 0..1000 (default 10)\n"
+            "  --json            machine-readable output on stdout\n",
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
+}
+
+static int parse_long(const char *s, long lo, long hi, long *out) {
+    char *end;
+    errno = 0;
+    long v = s && *s ? strtol(s, &end, 10) : 0;
+    if (!s || !*s || *end || errno || v < lo || v > hi) return -1;
+    *out = v;
+    return 0;
+}
+
+static int is_int(const char *s) {
+    if (*s == '-' || *s == '+') s++;
+    if (!*s) return 0;
+    for (; *s; s++)
+        if (*s < '0' || *s > '9') return 0;
+    return 1;
+}
+
+/* Values after a list option: the following arguments that are integers
+ * (comma-separated lists allowed).  Returns the count, -1 on error. */
+static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, long hi, int *out, int max) {
+    int n = 0;
+    while (*i + 1 < argc) {
+        const char *a = argv[*i + 1];
+        char buf[256];
+        snprintf(buf, sizeof buf, "%s", a);
+        int all = 1;
+        for (char *t = strtok(buf, ","); t; t = strtok(NULL, ","))
+            if (!is_int(t)) all = 0;
+        if (!all || !*a) break;
+        (*i)++;
+        snprintf(buf, sizeof buf, "%s", a);
+        for (char *t = strtok(buf, ","); t; t = strtok(NULL, ",")) {
+            long v;
+            if (parse_long(t, lo, hi, &v)) {
+                fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%s'\n", opt, lo, hi, t);
+                return -1;
+            }
+            if (n == max) {
+                fprintf(stderr, "cbvh sweep: %s takes at most %d values\n", opt, max);
+                return -1;
+            }
+            out[n++] = (int)v;
+        }
+    }
+    if (!n) {
+        fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%s'\n", opt, lo, hi,
+                *i + 1 < argc ? argv[*i + 1] : "");
+        return -1;
+    }
+    return n;
+}
+
+typedef struct {
+    int is_float;
+    int bits, mant, min_scale; /* mant/min_scale < -1000: the first of the lists */
+    int explicit_all;
+} heat_spec;
+
+static int parse_heat(const char *s, heat_spec *h) {
+    memset(h, 0, sizeof *h);
+    if (strcmp(s, "float") == 0) {
+        h->is_float = 1;
+        return 0;
+    }
+    char buf[64], *p[3];
+    snprintf(buf, sizeof buf, "%s", s);
+    int n = 0;
+    for (char *t = strtok(buf, ":"); t && n < 3; t = strtok(NULL, ":")) p[n++] = t;
+    long v[3];
+    if (n != 1 && n != 3) return -1;
+    if (strlen(s) >= sizeof buf) return -1;
+    for (int i = 0; i < n; i++)
+        if (parse_long(p[i], -126, 126, &v[i])) return -1;
+    if (v[0] < CBVH_N_MIN || v[0] > CBVH_N_MAX) return -1;
+    h->bits = (int)v[0];
+    if (n == 3) {
+        h->mant = (int)v[1];
+        h->min_scale = (int)v[2];
+        h->explicit_all = 1;
+    }
+    return 0;
+}
+
+typedef struct {
+    int tty;
+} prog_ctx;
+
+static void progress(void *ctx, const char *label, int setting, int settings, int row, int rows) {
+    (void)ctx;
+    if (row % 8 && row != rows - 1) return;
+    fprintf(stderr, "\rsweep %d/%d %-18s row %d/%d   ", setting, settings, label, row + 1, rows);
+}
+
+/* "sweep-" + the scene file's name without directory and extension. */
+static void default_out(const char *scene, char *out, size_t n) {
+    const char *b = strrchr(scene, '/');
+    b = b ? b + 1 : scene;
+    const char *dot = strrchr(b, '.');
+    size_t len = dot && dot > b ? (size_t)(dot - b) : strlen(b);
+    snprintf(out, n, "sweep-%.*s", (int)len, b);
+}
+
+static double rel(double a, double b) { return b > 0 ? a / b : (a > 0 ? 1e300 : 1); }
+
+static const char *metric_names[SWEEP_NMETRICS] = {"box tests", "triangle tests", "bytes", "modelled time",
+                                                  "CPU time"};
+static const char *metric_keys[SWEEP_NMETRICS] = {"box_per_ray", "tri_per_ray", "bytes_per_ray", "model_ns_per_ray",
+                                                 "cpu_us_per_ray"};
+
+static void print_rel(double r) {
+    if (r >= 1e299)
+        printf(" %7s", "inf");
+    else
+        printf(" %7.3f", r);
+}
+
+static void text_row(const char *setting, const char *effect, const cbvh_fx_stats *s, const cbvh_fx_stats *f,
+                     uint64_t mem, uint64_t fmem, const cbvh_timing_params *tp, const char *same) {
+    double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
+    cbvh_sweep_per_ray(s, tp, p);
+    cbvh_sweep_per_ray(f, tp, q);
+    printf("%-16s %-17s %8llu %8.2f %7.2f %8.1f %9.1f %7.2f |", setting, effect, (unsigned long long)s->rays,
+           p[SWEEP_BOX], p[SWEEP_TRI], p[SWEEP_BYTES], p[SWEEP_MODEL_NS], p[SWEEP_CPU_US]);
+    print_rel(rel(p[SWEEP_BOX], q[SWEEP_BOX]));
+    print_rel(rel(p[SWEEP_TRI], q[SWEEP_TRI]));
+    print_rel(rel(p[SWEEP_BYTES], q[SWEEP_BYTES]));
+    print_rel(rel((double)mem, (double)fmem));
+    print_rel(rel(p[SWEEP_MODEL_NS], q[SWEEP_MODEL_NS]));
+    print_rel(rel(p[SWEEP_CPU_US], q[SWEEP_CPU_US]));
+    printf("  %s\n", same);
+}
+
+static cJSON *json_costs(const cbvh_fx_stats *s, const cbvh_fx_stats *f, uint64_t mem, uint64_t fmem,
+                         const cbvh_timing_params *tp) {
+    double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
+    cbvh_sweep_per_ray(s, tp, p);
+    cbvh_sweep_per_ray(f, tp, q);
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "rays", (double)s->rays);
+    cJSON_AddNumberToObject(o, "hits", (double)s->hits);
+    cJSON_AddNumberToObject(o, "max_stack", s->st.max_stack);
+    for (int m = 0; m < SWEEP_NMETRICS; m++) cJSON_AddNumberToObject(o, metric_keys[m], p[m]);
+    cJSON *r = cJSON_AddObjectToObject(o, "relative_to_float");
+    static const char *rk[SWEEP_NMETRICS] = {"box_tests", "tri_tests", "bytes", "model_time", "cpu_time"};
+    for (int m = 0; m < SWEEP_NMETRICS; m++) {
+        double v = rel(p[m], q[m]);
+        cJSON_AddNumberToObject(r, rk[m], v >= 1e299 ? -1 : v);
+    }
+    cJSON_AddNumberToObject(r, "node_memory", rel((double)mem, (double)fmem));
+    return o;
+}
+
+/* Makes --out (and its parents); 0 or -1 (message printed). */
+static int ensure_dir(const char *dir) {
+    struct stat sb;
+    if (stat(dir, &sb) == 0) {
+        if (!S_ISDIR(sb.st_mode)) {
+            fprintf(stderr, "cbvh sweep: --out %s: exists and is not a directory\n", dir);
+            return -1;
+        }
+        return 0;
+    }
+    /* Like mkdir -p: the parents first. */
+    char buf[1024];
+    if (strlen(dir) >= sizeof buf) {
+        fprintf(stderr, "cbvh sweep: --out %s: path too long\n", dir);
+        return -1;
+    }
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (char *p = buf + 1; *p; p++)
+        if (*p == '/') {
+            *p = 0;
+            if (mkdir(buf, 0777) && errno != EEXIST) break; /* reported below */
+            *p = '/';
+        }
+    if (mkdir(dir, 0777) && errno != EEXIST) {
+        fprintf(stderr, "cbvh sweep: --out %s: cannot create: %s\n", dir, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+int cmd_sweep(int argc, char **argv) {
+    const char *scene = NULL, *outdir = NULL;
+    cbvh_sweep_opts o = {.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1};
+    int json = 0, nheat = 0, heat_given = 0;
+    long knee_pct = 10;
+    heat_spec heat[MAX_HEAT];
+    const char *corrupt = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--json") == 0)
+            json = 1;
+        else if (strcmp(a, "--bits") == 0) {
+            const char *v = i + 1 < argc ? argv[++i] : "";
+            char buf[64];
+            snprintf(buf, sizeof buf, "%s", v);
+            char *dd = strstr(buf, "..");
+            long lo, hi;
+            int bad;
+            if (dd) {
+                *dd = 0;
+                bad = parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo) || parse_long(dd + 2, CBVH_N_MIN, CBVH_N_MAX, &hi) ||
+                      lo > hi;
+            } else {
+                bad = parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo);
+                hi = lo;
+            }
+            if (bad || strlen(v) >= sizeof buf) {
+                fprintf(stderr, "cbvh sweep: --bits expects LO..HI or N within %d..%d (LO <= HI), got '%s'\n",
+                        CBVH_N_MIN, CBVH_N_MAX, v);
+                return 2;
+            }
+            o.bits_lo = (int)lo;
+            o.bits_hi = (int)hi;
+        } else if (strcmp(a, "--mant") == 0) {
+            if ((o.nmant = parse_list(a, argc, argv, &i, CBVH_MANT_MIN, CBVH_MANT_MAX, o.mant, CBVH_SWEEP_MAX_LIST)) < 0)
+                return 2;
+        } else if (strcmp(a, "--min-scale") == 0) {
+            if ((o.nmin_scale = parse_list(a, argc, argv, &i, -126, 126, o.min_scale, CBVH_SWEEP_MAX_LIST)) < 0)
+                return 2;
+        } else if (strcmp(a, "--spp") == 0) {
+            long v;
+            if (parse_long(i + 1 < argc ? argv[i + 1] : NULL, 1, 1024, &v)) {
+                fprintf(stderr, "cbvh sweep: --spp expects an integer in 1..1024, got '%s'\n",
+                        i + 1 < argc ? argv[i + 1] : "");
+                return 2;
+            }
+            i++;
+            o.spp = (int)v;
+        } else if (strcmp(a, "--knee") == 0) {
+            if (parse_long(i + 1 < argc ? argv[i + 1] : NULL, 0, 1000, &knee_pct)) {
+                fprintf(stderr, "cbvh sweep: --knee expects a percentage in 0..1000, got '%s'\n",
+                        i + 1 < argc ? argv[i + 1] : "");
+                return 2;
+            }
+            i++;
+        } else if (strcmp(a, "--out") == 0) {
+            if (i + 1 >= argc || !argv[i + 1][0]) {
+                fprintf(stderr, "cbvh sweep: --out expects a directory\n");
+                return 2;
+            }
+            outdir = argv[++i];
+        } else if (strcmp(a, "--heatmap") == 0) {
+            heat_given = 1;
+            int n0 = nheat;
+            while (i + 1 < argc && argv[i + 1][0] != '-' && (strcmp(argv[i + 1], "float") == 0 ||
+                                                              (argv[i + 1][0] >= '0' && argv[i + 1][0] <= '9'))) {
+                if (nheat == MAX_HEAT) {
+                    fprintf(stderr, "cbvh sweep: --heatmap takes at most %d settings\n", MAX_HEAT);
+                    return 2;
+                }
+                if (parse_heat(argv[i + 1], &heat[nheat])) {
+                    fprintf(stderr, "cbvh sweep: --heatmap expects float, N or N:M:E (N in %d..%d), got '%s'\n",
+                            CBVH_N_MIN, CBVH_N_MAX, argv[i + 1]);
+                    return 2;
+                }
+                nheat++;
+                i++;
+            }
+            if (nheat == n0) {
+                fprintf(stderr, "cbvh sweep: --heatmap expects float, N or N:M:E (N in %d..%d), got '%s'\n", CBVH_N_MIN,
+                        CBVH_N_MAX, i + 1 < argc ? argv[i + 1] : "");
+                return 2;
+            }
+        } else if (strcmp(a, "--test-corrupt") == 0) {
+            /* Test hook (docs/sweep.md): SETTING_INDEX:RAY_INDEX. */
+            corrupt = i + 1 < argc ? argv[++i] : "";
+            long si, ri;
+            char buf[64];
+            snprintf(buf, sizeof buf, "%s", corrupt);
+            char *c = strchr(buf, ':');
+            if (!c || (*c = 0, parse_long(buf, 0, 100000, &si)) || parse_long(c + 1, 0, 2000000000L, &ri)) {
+                fprintf(stderr, "cbvh sweep: --test-corrupt expects SETTING:RAY, got '%s'\n", corrupt);
+                return 2;
+            }
+            o.corrupt_setting = (int)si;
+            o.corrupt_ray = (uint64_t)ri;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "cbvh sweep: unknown option '%s' (see cbvh sweep --help)\n", a);
+            return 2;
+        } else if (scene) {
+            fprintf(stderr, "cbvh sweep: more than one scene ('%s', '%s')\n", scene, a);
+            return 2;
+        } else
+            scene = a;
+    }
+    if (!scene) {
+        fprintf(stderr, "cbvh sweep: no scene file given (see cbvh sweep --help)\n");
+        return 2;
+    }
+    if (!o.nmant) o.mant[o.nmant++] = CBVH_MANT_MAX;
+    if (!o.nmin_scale) o.min_scale[o.nmin_scale++] = CBVH_MIN_SCALE_DEFAULT;
+    if (!heat_given) {
+        heat[nheat++] = (heat_spec){.is_float = 1};
+        static const int def[] = {3, 6, 10};
+        for (int k = 0; k < 3; k++)
+            if (def[k] >= o.bits_lo && def[k] <= o.bits_hi) heat[nheat++] = (heat_spec){.bits = def[k]};
+    }
+    /* Every heat-map setting must be one the sweep traces. */
+    for (int h = 0; h < nheat; h++) {
+        heat_spec *s = &heat[h];
+        if (s->is_float) continue;
+        if (!s->explicit_all) {
+            s->mant = o.mant[0];
+            s->min_scale = o.min_scale[0];
+        }
+        int inm = 0, ine = 0;
+        for (int k = 0; k < o.nmant; k++) inm |= o.mant[k] == s->mant;
+        for (int k = 0; k < o.nmin_scale; k++) ine |= o.min_scale[k] == s->min_scale;
+        if (s->bits < o.bits_lo || s->bits > o.bits_hi || !inm || !ine) {
+            fprintf(stderr, "cbvh sweep: --heatmap %d:%d:%d is not a setting of this sweep\n", s->bits, s->mant,
+                    s->min_scale);
+            return 2;
+        }
+    }
+    char outbuf[1024];
+    if (!outdir) {
+        default_out(scene, outbuf, sizeof outbuf);
+        outdir = outbuf;
+    }
+    cbvh_scene_desc d;
+    char err[1024];
+    if (cbvh_scene_file_load(scene, &d, err, sizeof err)) {
+        fprintf(stderr, "cbvh sweep: %s\n", err);
+        return 2;
+    }
+    int nb = o.bits_hi - o.bits_lo + 1;
+    if (o.corrupt_setting >= nb * o.nmant * o.nmin_scale) {
+        fprintf(stderr, "cbvh sweep: --test-corrupt setting %d: the sweep has %d settings\n", o.corrupt_setting,
+                nb * o.nmant * o.nmin_scale);
+        cbvh_scene_desc_free(&d);
+        return 2;
+    }
+    if (ensure_dir(outdir)) {
+        cbvh_scene_desc_free(&d);
+        return 2;
+    }
+    int tty = isatty(2);
+    if (tty) o.progress = progress;
+    cbvh_timing_params tp;
+    cbvh_sweep_timing(&d, &tp);
+    cbvh_sweep_result res;
+    if (cbvh_sweep_run(&d, &o, &res, err, sizeof err)) {
+        if (tty) fprintf(stderr, "\n");
+        fprintf(stderr, "cbvh sweep: %s: %s\n", scene, err);
+        cbvh_scene_desc_free(&d);
+        return 1;
+    }
+    if (tty) fprintf(stderr, "\r%70s\r", "");
+
+    /* Relative totals per setting, for the knee and the chart. */
+    double tol = (double)knee_pct / 100.0;
+    int ncombo = o.nmant * o.nmin_scale;
+    cbvh_fx_stats ftot = cbvh_sweep_total(&res.ref.r);
+    double fq[SWEEP_NMETRICS];
+    cbvh_sweep_per_ray(&ftot, &tp, fq);
+    double *relv = calloc((size_t)res.nrows * SWEEP_NMETRICS, sizeof *relv);
+    int *bits = calloc((size_t)nb, sizeof *bits);
+    if (!relv || !bits) abort();
+    for (int b = 0; b < nb; b++) bits[b] = o.bits_lo + b;
+    for (int i = 0; i < res.nrows; i++) {
+        cbvh_fx_stats t = cbvh_sweep_total(&res.rows[i].r);
+        double p[SWEEP_NMETRICS];
+        cbvh_sweep_per_ray(&t, &tp, p);
+        for (int m = 0; m < SWEEP_NMETRICS; m++) relv[(size_t)m * res.nrows + i] = rel(p[m], fq[m]);
+    }
+    /* knee[c][m] for the four modelled metrics (CPU time is noisy: not a knee). */
+    int knee[CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];
+    for (int c = 0; c < ncombo; c++)
+        for (int m = 0; m < 4; m++) knee[c][m] = cbvh_sweep_knee(bits, &relv[(size_t)m * res.nrows + c * nb], nb, tol);
+
+    /* Outputs: chart(s) and heat maps. */
+    int status = res.all_same ? 0 : 1;
+    char path[2048], title[1400];
+    char written[16][2100];
+    int nwritten = 0;
+    double *x = calloc((size_t)nb, sizeof *x);
+    if (!x) abort();
+    for (int b = 0; b < nb; b++) x[b] = bits[b];
+    for (int c = 0; c < ncombo && nwritten < 8; c++) {
+        const cbvh_sweep_setting *s = &res.rows[c * nb].s;
+        if (ncombo == 1)
+            snprintf(path, sizeof path, "%s/cost.svg", outdir);
+        else
+            snprintf(path, sizeof path, "%s/cost-M%d-E%d.svg", outdir, s->mant, s->min_scale);
+        const char *mesh = strrchr(d.mesh_spec, '/');
+        snprintf(title, sizeof title, "%s: cost relative to the float BVH (M=%d, min scale %d)",
+                 mesh ? mesh + 1 : d.mesh_spec, s->mant, s->min_scale);
+        cbvh_svg_series ser[4];
+        for (int m = 0; m < 4; m++) ser[m] = (cbvh_svg_series){metric_names[m], &relv[(size_t)m * res.nrows + c * nb]};
+        int finite = 1;
+        for (int m = 0; m < 4; m++)
+            for (int b = 0; b < nb; b++) finite &= ser[m].y[b] < 1e299;
+        if (!finite) continue; /* the float BVH did none of something: no chart */
+        if (cbvh_svg_chart(path, title, "coordinate bits N", "cost / float BVH", x, (size_t)nb, ser, 4, err,
+                           sizeof err)) {
+            fprintf(stderr, "cbvh sweep: %s\n", err);
+            status = status ? status : 1;
+        } else
+            snprintf(written[nwritten++], sizeof written[0], "%s", path);
+    }
+    /* Heat maps on one colour scale: 0 .. the largest pixel of any chosen setting. */
+    const cbvh_sweep_run_t *hr[MAX_HEAT];
+    double vmax = 0;
+    size_t npx = (size_t)res.width * (size_t)res.height;
+    for (int h = 0; h < nheat; h++) {
+        hr[h] = &res.ref;
+        if (!heat[h].is_float)
+            for (int i = 0; i < res.nrows; i++)
+                if (res.rows[i].s.bits == heat[h].bits && res.rows[i].s.mant == heat[h].mant &&
+                    res.rows[i].s.min_scale == heat[h].min_scale)
+                    hr[h] = &res.rows[i];
+        for (size_t p = 0; p < npx; p++)
+            if (hr[h]->box_px[p] > vmax) vmax = hr[h]->box_px[p];
+    }
+    if (!(vmax > 0)) vmax = 1;
+    double used_min = 0, used_max = vmax;
+    for (int h = 0; h < nheat; h++) {
+        if (heat[h].is_float)
+            snprintf(path, sizeof path, "%s/heat-float.png", outdir);
+        else if (heat[h].explicit_all)
+            snprintf(path, sizeof path, "%s/heat-N%d-M%d-E%d.png", outdir, heat[h].bits, heat[h].mant,
+                     heat[h].min_scale);
+        else
+            snprintf(path, sizeof path, "%s/heat-N%d.png", outdir, heat[h].bits);
+        if (cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res.width, (unsigned)res.height, 0, vmax, 0, &used_min,
+                             &used_max, err, sizeof err)) {
+            fprintf(stderr, "cbvh sweep: %s\n", err);
+            status = status ? status : 1;
+        } else if (nwritten < 16)
+            snprintf(written[nwritten++], sizeof written[0], "%s", path);
+    }
+    snprintf(path, sizeof path, "%s/render-float.png", outdir);
+    if (cbvh_png_write(path, res.ref.image, (unsigned)res.width, (unsigned)res.height, 1, err, sizeof err)) {
+        fprintf(stderr, "cbvh sweep: %s\n", err);
+        status = status ? status : 1;
+    } else if (nwritten < 16)
+        snprintf(written[nwritten++], sizeof written[0], "%s", path);
+
+    int first_bad = -1;
+    for (int i = 0; i < res.nrows; i++)
+        if (!res.rows[i].same) {
+            first_bad = i;
+            break;
+        }
+    static const char *knee_keys[4] = {"box_tests", "tri_tests", "bytes", "model_time"};
+    if (json) {
+        cJSON *root = cJSON_CreateObject();
+        cJSON_AddStringToObject(root, "scene", scene);
+        cJSON_AddStringToObject(root, "mesh", d.mesh_spec);
+        cJSON_AddNumberToObject(root, "triangles", d.mesh.ntris);
+        cJSON_AddNumberToObject(root, "width", res.width);
+        cJSON_AddNumberToObject(root, "height", res.height);
+        cJSON_AddNumberToObject(root, "spp", res.spp);
+        cJSON_AddNumberToObject(root, "frames", res.frames);
+        cJSON_AddNumberToObject(root, "rays", (double)res.ref_rays);
+        cJSON *tj = cJSON_AddObjectToObject(root, "timing");
+        cJSON_AddNumberToObject(tj, "box_cycles", tp.box_cycles);
+        cJSON_AddNumberToObject(tj, "tri_cycles", tp.tri_cycles);
+        cJSON_AddNumberToObject(tj, "fetch_latency", tp.fetch_latency);
+        cJSON_AddNumberToObject(tj, "dram_bytes_per_cycle", tp.dram_bytes_per_cycle);
+        cJSON_AddNumberToObject(tj, "clock_mhz", tp.clock_mhz);
+        cJSON *fl = cJSON_AddObjectToObject(root, "float");
+        cJSON_AddNumberToObject(fl, "node_bytes", (double)res.ref.r.node_bytes);
+        cJSON *fe = cJSON_AddObjectToObject(fl, "effects");
+        for (int e = 0; e < CBVH_FX_COUNT; e++)
+            if (d.effect[e].enabled)
+                cJSON_AddItemToObject(fe, cbvh_effect_name((cbvh_effect)e),
+                                      json_costs(&res.ref.r.fx[e], &res.ref.r.fx[e], 1, 1, &tp));
+        cJSON_AddItemToObject(fl, "total", json_costs(&ftot, &ftot, 1, 1, &tp));
+        cJSON *rows = cJSON_AddArrayToObject(root, "settings");
+        for (int i = 0; i < res.nrows; i++) {
+            const cbvh_sweep_run_t *r = &res.rows[i];
+            cJSON *row = cJSON_CreateObject();
+            cJSON_AddNumberToObject(row, "bits", r->s.bits);
+            cJSON_AddNumberToObject(row, "mant", r->s.mant);
+            cJSON_AddNumberToObject(row, "min_scale", r->s.min_scale);
+            cJSON_AddNumberToObject(row, "node_bytes", (double)r->r.node_bytes);
+            cJSON_AddBoolToObject(row, "same_hits", r->same);
+            if (!r->same) cJSON_AddStringToObject(row, "first_difference", r->why);
+            cJSON *ef = cJSON_AddObjectToObject(row, "effects");
+            for (int e = 0; e < CBVH_FX_COUNT; e++)
+                if (d.effect[e].enabled)
+                    cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
+                                          json_costs(&r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
+                                                     res.ref.r.node_bytes, &tp));
+            cbvh_fx_stats t = cbvh_sweep_total(&r->r);
+            cJSON_AddItemToObject(row, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
+            cJSON_AddItemToArray(rows, row);
+        }
+        cJSON *kn = cJSON_AddArrayToObject(root, "knee");
+        for (int c = 0; c < ncombo; c++) {
+            cJSON *k = cJSON_CreateObject();
+            cJSON_AddNumberToObject(k, "mant", res.rows[c * nb].s.mant);
+            cJSON_AddNumberToObject(k, "min_scale", res.rows[c * nb].s.min_scale);
+            cJSON_AddNumberToObject(k, "tolerance", tol);
+            cJSON_AddNumberToObject(k, "reference_bits", o.bits_hi);
+            for (int m = 0; m < 4; m++) cJSON_AddNumberToObject(k, knee_keys[m], knee[c][m]);
+            cJSON_AddItemToArray(kn, k);
+        }
+        cJSON_AddBoolToObject(root, "same_hits", res.all_same);
+        cJSON_AddNumberToObject(root, "heatmap_max_box_tests", used_max);
+        cJSON *wr = cJSON_AddArrayToObject(root, "files");
+        for (int k = 0; k < nwritten; k++) cJSON_AddItemToArray(wr, cJSON_CreateString(written[k]));
+        char *txt = cJSON_PrintUnformatted(root);
+        printf("%s\n", txt);
+        free(txt);
+        cJSON_Delete(root);
+    } else {
+        printf("scene %s: %s, %u triangles, %dx%d, %d spp, %d frame%s; %llu rays per setting\n", scene, d.mesh_spec,
+               d.mesh.ntris, res.width, res.height, res.spp, res.frames, res.frames > 1 ? "s" : "",
+               (unsigned long long)res.ref_rays);
+        printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
+               "(docs/timing_model.md)\n\n",
+               tp.box_cycles, tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
+        printf("%-16s %-17s %8s %8s %7s %8s %9s %7s | %7s %7s %7s %7s %7s %7s  %s\n", "setting", "effect", "rays",
+               "box/ray", "tri/ray", "B/ray", "model ns", "CPU us", "box", "tri", "bytes", "memory", "model", "CPU",
+               "hits");
+        printf("%-16s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
+               "relative to the float BVH ----------------------------");
+        char name[48];
+        for (int i = -1; i < res.nrows; i++) {
+            const cbvh_sweep_run_t *r = i < 0 ? &res.ref : &res.rows[i];
+            if (i < 0)
+                snprintf(name, sizeof name, "float");
+            else
+                snprintf(name, sizeof name, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
+            const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
+            for (int e = 0; e < CBVH_FX_COUNT; e++)
+                if (d.effect[e].enabled)
+                    text_row(name, cbvh_effect_name((cbvh_effect)e), &r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
+                             res.ref.r.node_bytes, &tp, same);
+            cbvh_fx_stats t = cbvh_sweep_total(&r->r);
+            text_row(name, "total", &t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp, same);
+        }
+        printf("\nnode memory: float BVH %llu B", (unsigned long long)res.ref.r.node_bytes);
+        for (int b = 0; b < nb; b++) printf(", N=%d %llu B", res.rows[b].s.bits, (unsigned long long)res.rows[b].r.node_bytes);
+        printf("\n");
+        printf("knee = smallest N from which every finer N costs at most %ld%% more than N=%d (totals over effects):\n",
+               knee_pct, o.bits_hi);
+        for (int c = 0; c < ncombo; c++) {
+            printf("  M=%d E=%d:", res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale);
+            for (int m = 0; m < 4; m++)
+                printf("%s %s N=%d", m ? "," : "", metric_names[m], knee[c][m]);
+            printf("\n");
+        }
+        for (int c = 0; c < ncombo; c++)
+            for (int b = 0; b < nb; b++)
+                if (bits[b] == 6 && res.rows[c * nb].s.mant == CBVH_MANT_MAX)
+                    printf("paper (Viitanen et al., CBVH at N=6): box tests x1.08, triangle tests x1.13; here (M=%d "
+                           "E=%d): box tests x%.3f, triangle tests x%.3f\n",
+                           res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale,
+                           relv[(size_t)SWEEP_BOX * res.nrows + c * nb + b],
+                           relv[(size_t)SWEEP_TRI * res.nrows + c * nb + b]);
+        if (res.all_same)
+            printf("hits: all %d settings return the float BVH's hits on all %llu rays (same triangle and t bits; no "
+                   "false misses) and render the same %dx%d image\n",
+                   res.nrows, (unsigned long long)res.ref_rays, res.width, res.height);
+        else
+            for (int i = 0; i < res.nrows; i++)
+                if (!res.rows[i].same)
+                    printf("hits: N=%d M=%d E=%d DIFFERENT from the float BVH: %s\n", res.rows[i].s.bits,
+                           res.rows[i].s.mant, res.rows[i].s.min_scale, res.rows[i].why);
+        printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all\n", used_max);
+        for (int k = 0; k < nwritten; k++) printf("wrote %s\n", written[k]);
+    }
+    if (first_bad >= 0) {
+        const cbvh_sweep_run_t *r = &res.rows[first_bad];
+        fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits, r->s.mant,
+                r->s.min_scale, r->why);
+    }
+    free(x);
+    free(bits);
+    free(relv);
+    cbvh_sweep_free(&res);
+    cbvh_scene_desc_free(&d);
+    return status;
+}

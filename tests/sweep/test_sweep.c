@@ -1,0 +1,219 @@
+/* cbvh sweep core (host/sweep.c, docs/sweep.md): the rows, the relative
+ * costs at the extremes, the ray-by-ray identity check (and that a corrupted
+ * setting fails it), the heat-map data and the knee rule. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "sweep.h"
+
+static cbvh_scene_desc scene;
+static cbvh_sweep_result res; /* bits 3..10 x M {24, 8} x E {-30} */
+static cbvh_timing_params tp;
+
+static int setup(void **state) {
+    (void)state;
+    char err[512];
+    if (cbvh_scene_file_load(SWEEP_FIXTURES "/tiny.scene", &scene, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
+    cbvh_sweep_opts o = {.bits_lo = 3, .bits_hi = 10, .mant = {24, 8}, .nmant = 2, .min_scale = {-30},
+                         .nmin_scale = 1, .corrupt_setting = -1};
+    if (cbvh_sweep_run(&scene, &o, &res, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
+    cbvh_sweep_timing(&scene, &tp);
+    return 0;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    cbvh_sweep_free(&res);
+    cbvh_scene_desc_free(&scene);
+    return 0;
+}
+
+static double rel_total(const cbvh_sweep_run_t *r, int metric) {
+    cbvh_fx_stats a = cbvh_sweep_total(&r->r), f = cbvh_sweep_total(&res.ref.r);
+    double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
+    cbvh_sweep_per_ray(&a, &tp, p);
+    cbvh_sweep_per_ray(&f, &tp, q);
+    return p[metric] / q[metric];
+}
+
+static const cbvh_sweep_run_t *row(int bits, int mant) {
+    for (int i = 0; i < res.nrows; i++)
+        if (res.rows[i].s.bits == bits && res.rows[i].s.mant == mant) return &res.rows[i];
+    return NULL;
+}
+
+static void test_rows(void **state) {
+    (void)state;
+    assert_int_equal(res.nrows, 16); /* 8 N x 2 M x 1 E */
+    /* Order: for each M, each E, N ascending. */
+    for (int i = 0; i < 16; i++) {
+        assert_int_equal(res.rows[i].s.bits, 3 + i % 8);
+        assert_int_equal(res.rows[i].s.mant, i < 8 ? 24 : 8);
+        assert_int_equal(res.rows[i].s.min_scale, -30);
+    }
+    /* Every setting traced exactly the reference's rays, per effect. */
+    assert_true(res.ref_rays > 300);
+    for (int i = 0; i < res.nrows; i++)
+        for (int e = 0; e < CBVH_FX_COUNT; e++) assert_int_equal(res.rows[i].r.fx[e].rays, res.ref.r.fx[e].rays);
+    assert_int_equal(cbvh_sweep_total(&res.ref.r).rays, res.ref_rays);
+    assert_int_equal(res.ref.r.fx[CBVH_FX_MIRROR].rays, 0); /* not in the scene */
+    assert_true(res.ref.r.fx[CBVH_FX_AMBIENT_OCCLUSION].rays > 0);
+}
+
+static void test_relative_costs(void **state) {
+    (void)state;
+    /* N = 10 with a full-width box unit: within a few percent of the float BVH. */
+    double b10 = rel_total(row(10, 24), SWEEP_BOX), t10 = rel_total(row(10, 24), SWEEP_TRI);
+    assert_true(b10 >= 1.0 && b10 < 1.05);
+    assert_true(t10 >= 1.0 && t10 < 1.05);
+    /* N = 3: clearly more work; and never less than the float BVH (boxes only grow). */
+    double b3 = rel_total(row(3, 24), SWEEP_BOX), t3 = rel_total(row(3, 24), SWEEP_TRI);
+    assert_true(b3 > b10 + 0.2);
+    assert_true(t3 > t10 + 0.2);
+    assert_true(rel_total(row(3, 24), SWEEP_MODEL_NS) > rel_total(row(10, 24), SWEEP_MODEL_NS));
+    /* A narrower box unit only loosens the test: at least as much work. */
+    for (int b = 3; b <= 10; b++) assert_true(rel_total(row(b, 8), SWEEP_BOX) >= rel_total(row(b, 24), SWEEP_BOX));
+    /* Node memory: 16-byte pairs up to N = 6, 24-byte from N = 7, both below the float BVH. */
+    assert_true(row(6, 24)->r.node_bytes < row(7, 24)->r.node_bytes);
+    assert_true(row(10, 24)->r.node_bytes < res.ref.r.node_bytes);
+    assert_int_equal(row(3, 24)->r.node_bytes, row(6, 24)->r.node_bytes);
+}
+
+static void test_identity_passes(void **state) {
+    (void)state;
+    assert_true(res.all_same);
+    size_t npx = (size_t)res.width * (size_t)res.height;
+    int lit = 0;
+    for (size_t p = 0; p < npx; p++) lit += res.ref.image[p] > 0;
+    assert_true(lit > 20 && lit < (int)npx); /* the image shows the bunny, not a blank frame */
+    for (int i = 0; i < res.nrows; i++) {
+        assert_true(res.rows[i].same);
+        assert_memory_equal(res.rows[i].image, res.ref.image, npx);
+        assert_int_equal(res.rows[i].r.hit_digest, res.ref.r.hit_digest);
+    }
+}
+
+static void test_heatmap_data(void **state) {
+    (void)state;
+    /* Per-pixel box tests add up to the primary effect's box tests (1 spp, static). */
+    for (int i = -1; i < res.nrows; i++) {
+        const cbvh_sweep_run_t *r = i < 0 ? &res.ref : &res.rows[i];
+        double sum = 0;
+        for (size_t p = 0; p < (size_t)res.width * (size_t)res.height; p++) sum += r->box_px[p];
+        assert_true(sum == (double)r->r.fx[CBVH_FX_PRIMARY].st.box_tests);
+    }
+}
+
+/* A setting that returns one wrong answer must fail the check, naming the ray. */
+static void corrupt_run(uint64_t ray, cbvh_sweep_result *out) {
+    cbvh_sweep_opts o = {.bits_lo = 5, .bits_hi = 6, .mant = {24}, .nmant = 1, .min_scale = {-30},
+                         .nmin_scale = 1, .corrupt_setting = 1, .corrupt_ray = ray};
+    char err[256];
+    assert_int_equal(cbvh_sweep_run(&scene, &o, out, err, sizeof err), 0);
+    assert_int_equal(out->nrows, 2);
+    assert_true(out->rows[0].same);
+    assert_false(out->rows[1].same);
+    assert_false(out->all_same);
+    assert_int_equal(out->rows[1].bad_ray, ray);
+}
+
+/* Trace-order index of the first primary hit: pixels before the first lit one
+ * are primary misses with no secondary rays, one ray each (1 spp). */
+static uint64_t first_hit_ray(void) {
+    int first = -1;
+    for (int p = 0; p < res.width * res.height && first < 0; p++)
+        if (res.ref.image[p]) first = p;
+    assert_true(first > 0);
+    return (uint64_t)first;
+}
+
+static void test_corrupted_miss_fails(void **state) {
+    (void)state;
+    cbvh_sweep_result r;
+    corrupt_run(0, &r); /* pixel (0,0) sees the sky: a miss turned into a hit */
+    assert_non_null(strstr(r.rows[1].why, "ray 0 (primary, pixel 0,0"));
+    assert_non_null(strstr(r.rows[1].why, "false hit"));
+    cbvh_sweep_free(&r);
+}
+
+static void test_corrupted_t_fails(void **state) {
+    (void)state;
+    uint64_t first = first_hit_ray();
+    cbvh_sweep_result r;
+    corrupt_run(first, &r); /* t one ulp off on a primary hit */
+    assert_non_null(strstr(r.rows[1].why, "t=0x"));
+    assert_int_equal(r.rows[1].bad_px, (int)(first % (uint64_t)res.width));
+    assert_int_equal(r.rows[1].bad_py, (int)(first / (uint64_t)res.width));
+    cbvh_sweep_free(&r);
+}
+
+static void test_corrupted_anyhit_fails(void **state) {
+    (void)state;
+    /* The ray after the first primary hit is that point's first any-hit ray
+     * (a shadow ray, or AO when the light is behind the surface). */
+    uint64_t ray = first_hit_ray() + 1;
+    cbvh_sweep_result r;
+    corrupt_run(ray, &r);
+    assert_true(r.rows[1].bad_fx == CBVH_FX_HARD_SHADOWS || r.rows[1].bad_fx == CBVH_FX_AMBIENT_OCCLUSION);
+    assert_true(strstr(r.rows[1].why, "false miss") || strstr(r.rows[1].why, "false hit"));
+    cbvh_sweep_free(&r);
+}
+
+static void test_knee_rule(void **state) {
+    (void)state;
+    int bits[] = {3, 4, 5, 6};
+    double a[] = {1.6, 1.2, 1.05, 1.0};
+    assert_int_equal(cbvh_sweep_knee(bits, a, 4, 0.10), 5);
+    assert_int_equal(cbvh_sweep_knee(bits, a, 4, 0.25), 4);
+    assert_int_equal(cbvh_sweep_knee(bits, a, 4, 0.0), 6);
+    double b[] = {1.0, 1.0, 1.3, 1.0}; /* a bump after a low value: the knee is after the bump */
+    assert_int_equal(cbvh_sweep_knee(bits, b, 4, 0.10), 6);
+    double c[] = {0.8, 0.9, 1.0, 1.0}; /* cheaper than the finest: within from the start */
+    assert_int_equal(cbvh_sweep_knee(bits, c, 4, 0.10), 3);
+    assert_int_equal(cbvh_sweep_knee(bits, c, 1, 0.10), 3);
+}
+
+static void test_bad_options(void **state) {
+    (void)state;
+    cbvh_sweep_result r;
+    char err[256];
+    cbvh_sweep_opts o = {.bits_lo = 2, .bits_hi = 10, .mant = {24}, .nmant = 1, .min_scale = {-30}, .nmin_scale = 1,
+                         .corrupt_setting = -1};
+    assert_int_equal(cbvh_sweep_run(&scene, &o, &r, err, sizeof err), -1);
+    assert_non_null(strstr(err, "--bits"));
+    o.bits_lo = 3;
+    o.mant[0] = 25;
+    assert_int_equal(cbvh_sweep_run(&scene, &o, &r, err, sizeof err), -1);
+    assert_non_null(strstr(err, "--mant 25"));
+    o.mant[0] = 24;
+    o.min_scale[0] = -127;
+    assert_int_equal(cbvh_sweep_run(&scene, &o, &r, err, sizeof err), -1);
+    assert_non_null(strstr(err, "--min-scale -127"));
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rows),
+        cmocka_unit_test(test_relative_costs),
+        cmocka_unit_test(test_identity_passes),
+        cmocka_unit_test(test_heatmap_data),
+        cmocka_unit_test(test_corrupted_miss_fails),
+        cmocka_unit_test(test_corrupted_anyhit_fails),
+        cmocka_unit_test(test_corrupted_t_fails),
+        cmocka_unit_test(test_knee_rule),
+        cmocka_unit_test(test_bad_options),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
