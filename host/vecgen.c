@@ -3,6 +3,7 @@
  * bit patterns, so the files are identical on every host. */
 #include "vecgen.h"
 
+#include "cbvh/qbvh.h"
 #include "cbvh/traversal_units.h"
 
 #include <stdio.h>
@@ -885,6 +886,66 @@ static void gen_ray_triangle(gen_t *g, size_t target) {
     }
 }
 
+/* ---- qbvh_stack (docs/qbvh.md §2) ------------------------------------------------ */
+
+static void emit_qstack(gen_t *g, uint32_t op, uint32_t first, uint32_t mask, const cbvh_f32 t[4], uint32_t entry) {
+    uint32_t in[8] = {op, first, mask, t[0], t[1], t[2], t[3], entry};
+    emit(g, in);
+}
+
+static void gen_qbvh_stack(gen_t *g, size_t target) {
+    static const cbvh_f32 zero_t[4] = {0, 0, 0, 0};
+    if (!g->random_only) {
+        /* every hit mask x hit-time patterns: distinct, all equal, pairs equal, +-0, Inf, FLT_MAX, reversed */
+        static const cbvh_f32 tp[][4] = {
+            {F_ONE, 0x40000000u, 0x40400000u, 0x40800000u}, {0x40800000u, 0x40400000u, 0x40000000u, F_ONE},
+            {F_ONE, F_ONE, F_ONE, F_ONE},                   {0, CBVH_F32_SIGN, 0, CBVH_F32_SIGN},
+            {0x40000000u, F_ONE, 0x40000000u, F_ONE},       {CBVH_F32_MAX, CBVH_F32_POS_INF, F_HALF, CBVH_F32_MAX},
+            {0xBF800000u, F_ONE, CBVH_F32_NEG_INF, 0},      {0x3F800001u, F_ONE, 0x3F7FFFFFu, F_ONE}};
+        static const uint32_t firsts[] = {0, 1, 5, 0x3FFFFFCu, 0x3FFFFFFu, 0x4000000u, 0xFFFFFFFFu};
+        for (size_t k = 0; k < sizeof tp / sizeof tp[0]; k++)
+            for (uint32_t m = 0; m < 16; m++) emit_qstack(g, 0, 5, m, tp[k], 0);
+        for (size_t f = 0; f < sizeof firsts / sizeof firsts[0]; f++) {
+            emit_qstack(g, 0, firsts[f], 15, tp[1], 0);
+            emit_qstack(g, 0, firsts[f], 1, tp[1], 0); /* one hit: nothing pushed, ID still checked */
+        }
+        /* rejects: NaN hit time (hit and not hit), mask > 15, bad op */
+        const cbvh_f32 tn[4] = {F_ONE, 0x7FC00000u, 0x40000000u, 0x7F800001u};
+        emit_qstack(g, 0, 5, 15, tn, 0);
+        emit_qstack(g, 0, 5, 5, tn, 0);
+        emit_qstack(g, 0, 5, 16, tp[0], 0);
+        emit_qstack(g, 2, 5, 15, tp[0], 0);
+        emit_qstack(g, 0xF, 5, 15, tp[0], 0);
+        /* pop: every offset block with IDs at the ends of the 26-bit range */
+        static const uint32_t ids[] = {0, 7, 0x3FFFFFCu, 0x3FFFFFFu};
+        for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++)
+            for (uint32_t b = 0; b < 64; b++) emit_qstack(g, 1, 0, 0, zero_t, ids[i] | b << 26);
+    }
+    while (g->n < target && !g->oom) {
+        uint32_t op = (uint32_t)rnd_below(&g->rng, 2);
+        if (op == 1) {
+            uint32_t entry = (uint32_t)rng_next(&g->rng);
+            emit_qstack(g, 1, 0, 0, zero_t, entry);
+            continue;
+        }
+        uint32_t first = (uint32_t)rnd_below(&g->rng, CBVH_QSTACK_ID_LIMIT + 4u);
+        uint32_t mask = (uint32_t)rnd_below(&g->rng, 16);
+        cbvh_f32 t[4];
+        uint64_t tie = rnd_below(&g->rng, 4); /* 1 in 4: hit times from a set of two values */
+        cbvh_f32 a = rnd_float(&g->rng);
+        cbvh_f32 b = rnd_float(&g->rng);
+        for (int c = 0; c < 4; c++) {
+            if (tie == 0) {
+                uint64_t pick = rnd_below(&g->rng, 2);
+                t[c] = pick ? a : b;
+            } else {
+                t[c] = rnd_float(&g->rng);
+            }
+        }
+        emit_qstack(g, 0, first, mask, t, 0);
+    }
+}
+
 /* ---- files ------------------------------------------------------------------- */
 
 /* Vectors of a level-1 file per unit (the committed set stays small). */
@@ -894,6 +955,7 @@ static size_t level1_target(const cbvh_unit *u) {
     if (strcmp(u->name, "axis_decode") == 0) return 1500;
     if (strcmp(u->name, "ray_box") == 0) return 1500;
     if (strcmp(u->name, "ray_triangle") == 0) return 1500;
+    if (strcmp(u->name, "qbvh_stack") == 0) return 2000;
     return 500;
 }
 
@@ -937,6 +999,7 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     else if (strcmp(s->unit->name, "nodepair_decode") == 0) fn = gen_decode_pair;
     else if (strcmp(s->unit->name, "ray_box") == 0) fn = gen_ray_box;
     else if (strcmp(s->unit->name, "ray_triangle") == 0) fn = gen_ray_triangle;
+    else if (strcmp(s->unit->name, "qbvh_stack") == 0) fn = gen_qbvh_stack;
     if (!fn) return -1;
     fn(&g, target);
     if (s->level >= 2) {
@@ -969,7 +1032,9 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
 }
 
 /* The traversal units do not depend on N or min_scale: one file (N = 6) in the default set. */
-static int is_ray_unit(const cbvh_unit *u) { return strncmp(u->name, "ray_", 4) == 0; }
+static int is_ray_unit(const cbvh_unit *u) {
+    return strncmp(u->name, "ray_", 4) == 0 || strcmp(u->name, "qbvh_stack") == 0; /* qbvh_stack: no N either */
+}
 static int is_axis_unit(const cbvh_unit *u) { return strncmp(u->name, "nodepair", 8) != 0 && !is_ray_unit(u); }
 
 size_t cbvh_vecgen_specs(const cbvh_vecgen_select *sel, cbvh_vecgen_spec *out, size_t max) {

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
+#include "cbvh/qbvh.h"
 
 static void add(cbvh_field *f, int *n, const char *name, int digits) {
     f[*n].name = name;
@@ -277,6 +278,54 @@ static void ray_tri_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32
     out[4] = st;
 }
 
+/* ---- qbvh_stack (docs/qbvh.md §2) ---- */
+static void qstack_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    add(l->in, &l->n_in, "op", 1); /* 0 = sort + push, 1 = pop */
+    add(l->in, &l->n_in, "first", F32);
+    add(l->in, &l->n_in, "hit_mask", 1);
+    add(l->in, &l->n_in, "t0", F32);
+    add(l->in, &l->n_in, "t1", F32);
+    add(l->in, &l->n_in, "t2", F32);
+    add(l->in, &l->n_in, "t3", F32);
+    add(l->in, &l->n_in, "entry", 8);
+    add(l->out, &l->n_out, "node", 8);
+    add(l->out, &l->n_out, "next_entry", 8);
+    add(l->out, &l->n_out, "write", 1);
+    add(l->out, &l->n_out, "order", 2);
+    add(l->out, &l->n_out, "nhit", 1);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void qstack_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    (void)cfg;
+    for (int i = 0; i < 6; i++) out[i] = 0;
+    if (in[0] == 1) {
+        int keep;
+        out[5] = cbvh_qstack_pop(in[7], &out[0], &out[1], &keep);
+        out[2] = (uint32_t)keep;
+        return;
+    }
+    if (in[0] != 0) {
+        out[5] = CBVH_ST_BAD_PARAM;
+        return;
+    }
+    uint8_t order[4];
+    int nhit;
+    uint32_t st = cbvh_qstack_sort(in + 3, in[2], order, &nhit);
+    uint32_t entry = 0;
+    if (!st) st = cbvh_qstack_push(in[1], order, nhit, &entry);
+    if (st) {
+        out[5] = st;
+        return;
+    }
+    out[0] = nhit ? in[1] + order[0] : 0;
+    out[1] = entry;
+    out[2] = nhit >= 2;
+    out[3] = (uint32_t)order[0] | (uint32_t)order[1] << 2 | (uint32_t)order[2] << 4 | (uint32_t)order[3] << 6;
+    out[4] = (uint32_t)nhit;
+}
+
 static const cbvh_unit unit_estimate = {"scale_estimate", 1, 0, estimate_layout, estimate_eval};
 static const cbvh_unit unit_compress = {"axis_compress", 2, 0, compress_layout, compress_eval};
 static const cbvh_unit unit_decode = {"axis_decode", 3, 1, decode_layout, decode_eval};
@@ -284,9 +333,11 @@ static const cbvh_unit unit_encode_pair = {"nodepair_encode", 4, 1, encode_layou
 static const cbvh_unit unit_decode_pair = {"nodepair_decode", 5, 1, decode_pair_layout, decode_pair_eval};
 static const cbvh_unit unit_ray_box = {"ray_box", 6, 0, ray_box_layout, ray_box_eval};
 static const cbvh_unit unit_ray_triangle = {"ray_triangle", 7, 0, ray_tri_layout, ray_tri_eval};
+static const cbvh_unit unit_qbvh_stack = {"qbvh_stack", 8, 0, qstack_layout, qstack_eval};
 
 const cbvh_unit *const cbvh_units[] = {&unit_estimate, &unit_compress, &unit_decode, &unit_encode_pair,
-                                       &unit_decode_pair, &unit_ray_box, &unit_ray_triangle};
+                                       &unit_decode_pair, &unit_ray_box, &unit_ray_triangle,
+                                       &unit_qbvh_stack};
 const int cbvh_unit_count = (int)(sizeof cbvh_units / sizeof cbvh_units[0]);
 
 const cbvh_unit *cbvh_unit_find(const char *name) {

@@ -1,0 +1,100 @@
+/* QBVH (seed 000, Bogolepov & Ulyanov): a binned-SAH binary BVH collapsed
+ * into a 4-ary BVH whose siblings are contiguous, traversed with the paper's
+ * compressed 32-bit stack entry.  Spec: docs/qbvh.md. */
+#ifndef CBVH_QBVH_H
+#define CBVH_QBVH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cbvh/bvh.h"
+#include "cbvh/traverse.h"
+
+/* ---- the stack unit (unit 8, rtl-model/src/qbvh_stack.c) --------------------
+ * Entry: bits 25..0 first-child ID, bits 27..26 / 29..28 / 31..30 the offsets
+ * o0, o1, o2 (0..3) of the siblings still to visit, near to far.  A missing
+ * far sibling repeats the previous offset; an entry is exhausted when the
+ * offset after the popped one equals it. */
+#define CBVH_QSTACK_ID_BITS 26
+#define CBVH_QSTACK_ID_LIMIT (UINT32_C(1) << CBVH_QSTACK_ID_BITS) /* first-child IDs must be below */
+
+/* 5-comparator sorting network (pairs (0,1) (2,3) (0,2) (1,3) (1,2)) on the key
+ * (missed, t, index): hit children first, by t (binary32 total order, -0 = +0),
+ * ties by child index.  t of a missed child is ignored.  order[0] is the
+ * nearest child; *nhit = number of hit children.  Status: NAN_INF if a hit
+ * child's t is NaN, BAD_PARAM if hit_mask > 15 (then every output is 0). */
+uint32_t cbvh_qstack_sort(const uint32_t t[4], uint32_t hit_mask, uint8_t order[4], int *nhit);
+
+/* Push: the entry for the deferred children order[1 .. nhit-1] (nhit >= 2;
+ * for nhit < 2 nothing is pushed and *entry = 0).  BAD_CODE if
+ * first >= 2^26 (never wraps), BAD_PARAM if nhit > 4 or order[] is not a
+ * permutation of 0..3; every output 0 then. */
+uint32_t cbvh_qstack_push(uint32_t first, const uint8_t order[4], int nhit, uint32_t *entry);
+
+/* Pop: *node = first + o0; *keep = 1 and *next = the shifted entry
+ * (o1, o2, o2) if o1 != o0, else *keep = 0 (entry exhausted: drop it) and
+ * *next = 0.  Every 32-bit entry is valid input (status 0). */
+uint32_t cbvh_qstack_pop(uint32_t entry, uint32_t *node, uint32_t *next, int *keep);
+
+/* The same offset logic on a 64-bit entry (bits 31..0 first-child ID, bits
+ * 37..32 the offsets): the "wide entry" for trees past 2^26 nodes. */
+uint64_t cbvh_qstack_push_wide(uint32_t first, const uint8_t order[4], int nhit);
+uint32_t cbvh_qstack_pop_wide(uint64_t entry, uint64_t *next, int *keep);
+
+/* ---- the QBVH (rtl-model/src/build_qbvh.c) --------------------------------
+ * Structure of arrays, node 0 = root (its own box in bmin/bmax[0]).  Node i:
+ *   inner: children first[i] .. first[i]+count[i]-1 (2..4), contiguous
+ *   leaf (count[i] & CBVH_QBVH_LEAF): primitives prims[first[i] ..
+ *         first[i] + (count[i] & ~CBVH_QBVH_LEAF)).
+ * Memory image (bytes): bmin, bmax as 16-byte float4 (x, y, z, pad) and the
+ * info pair (first, count) as 8 bytes: 40 bytes per node. */
+#define CBVH_QBVH_LEAF 0x80000000u
+#define CBVH_QBVH_NODE_BYTES 40u
+
+typedef struct {
+    uint32_t nnodes;
+    float (*bmin)[4], (*bmax)[4];
+    uint32_t *first, *count;
+    uint32_t *prims; /* triangle indices, grouped by leaf */
+    uint32_t nprims;
+    uint32_t max_first; /* largest first-child ID of an inner node (0 if none) */
+    uint32_t depth;     /* levels below the root (0: the root is a leaf) */
+} cbvh_qbvh;
+
+void cbvh_qbvh_free(cbvh_qbvh *q);
+
+/* Collapse a binary BVH (any builder; the paper uses cbvh_build_sah) into a
+ * QBVH: each node takes up to 4 children by repeatedly opening the inner
+ * child of largest surface area; children keep the binary left-to-right
+ * order and are laid out breadth-first.  0, or -1 + one-line reason. */
+int cbvh_qbvh_from_bvh(const cbvh_bvh *b, cbvh_qbvh *out, char *err, size_t errlen);
+
+/* Structure check: every node reachable once, counts 2..4, every primitive in
+ * one leaf, boxes enclose children / triangles.  0 or -1 + reason. */
+int cbvh_qbvh_check(const cbvh_qbvh *q, const cbvh_scene *s, char *err, size_t errlen);
+
+/* Bytes of the node arrays (CBVH_QBVH_NODE_BYTES per node). */
+size_t cbvh_qbvh_node_bytes(const cbvh_qbvh *q);
+
+/* ---- traversal (rtl-model/src/traverse_qbvh.c) ---------------------------- */
+typedef enum {
+    CBVH_QSTACK_AUTO = 0,       /* compressed 32-bit if the tree fits 2^26, else wide */
+    CBVH_QSTACK_COMPRESSED = 1, /* the paper's 32-bit entry (the unit); error past 2^26 */
+    CBVH_QSTACK_WIDE = 2,       /* 64-bit entry, same algorithm */
+    CBVH_QSTACK_PLAIN = 3,      /* one node ID per entry (comparison) */
+} cbvh_qstack_kind;
+
+/* 0, or -1 + reason if `kind` cannot address this tree (compressed entry and
+ * a first-child ID >= 2^26). */
+int cbvh_qbvh_stack_check(const cbvh_qbvh *q, cbvh_qstack_kind kind, char *err, size_t errlen);
+
+/* Closest hit / any hit with the ray-box unit (float boxes, M = mant_bits)
+ * and the ray-triangle unit; same result definition as cbvh_trace_bvh
+ * (docs/traversal.md §5), so the closest hit equals the binary BVH's bit for
+ * bit.  Stats: nodes = inner nodes visited, max_stack = deepest number of
+ * stack entries (deferred work only).  0, or -1 (ray rejected, stack
+ * overflow, or the tree does not fit the stack kind). */
+int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
+                    cbvh_trav_mode mode, cbvh_qstack_kind kind, cbvh_trav_hit *hit, cbvh_trav_stats *st);
+
+#endif
