@@ -6,7 +6,6 @@
  *      model's time and CPU time relative to the float BVH, with a proof that
  *      every CBVH gives exactly the float BVH's hits. */
 #include <getopt.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,16 +48,6 @@ typedef struct {
     double box, tri, bytes, model_ns, cpu_us; /* per ray, all effects */
 } width_row;
 
-static void timing_params(const cbvh_scene_desc *d, cbvh_timing_params *tp) {
-    cbvh_timing_defaults(tp);
-    const cbvh_timing_overrides *o = &d->timing;
-    if (!isnan(o->box_cycles)) tp->box_cycles = o->box_cycles;
-    if (!isnan(o->tri_cycles)) tp->tri_cycles = o->tri_cycles;
-    if (!isnan(o->fetch_latency)) tp->fetch_latency = o->fetch_latency;
-    if (!isnan(o->dram_bytes_per_cycle)) tp->dram_bytes_per_cycle = o->dram_bytes_per_cycle;
-    if (!isnan(o->clock_mhz)) tp->clock_mhz = o->clock_mhz;
-}
-
 /* Traces the scene in one format and sums the per-effect counters. */
 static int measure(const cbvh_scene_desc *d, const cbvh_timing_params *tp, int bits, width_row *row, char *err,
                    size_t errlen) {
@@ -70,19 +59,11 @@ static int measure(const cbvh_scene_desc *d, const cbvh_timing_params *tp, int b
     o.mant = 24;
     cbvh_fx_result r;
     if (cbvh_fx_run(d, &o, &r, err, errlen) != 0) return -1;
-    cbvh_timing_work w = {0, 0, 0, 0};
-    double cpu = 0;
+    cbvh_fx_stats t = cbvh_fx_total(&r);
+    cbvh_timing_work w = {t.st.box_tests, t.st.tri_tests, t.st.nodes, t.st.bytes};
     memset(row, 0, sizeof *row);
     row->bits = bits;
-    for (int e = 0; e < CBVH_FX_COUNT; e++) {
-        const cbvh_fx_stats *s = &r.fx[e];
-        row->rays += s->rays;
-        w.box_tests += s->st.box_tests;
-        w.tri_tests += s->st.tri_tests;
-        w.node_fetches += s->st.nodes;
-        w.bytes += s->st.bytes;
-        cpu += s->cpu_seconds;
-    }
+    row->rays = t.rays;
     cbvh_timing_result tr;
     if (cbvh_timing_eval(tp, &w, &tr) != 0 || row->rays == 0) {
         snprintf(err, errlen, "scene traces no rays or has an invalid timing model");
@@ -95,7 +76,7 @@ static int measure(const cbvh_scene_desc *d, const cbvh_timing_params *tp, int b
     row->tri = (double)w.tri_tests / n;
     row->bytes = (double)w.bytes / n;
     row->model_ns = tr.seconds * 1e9 / n;
-    row->cpu_us = cpu * 1e6 / n;
+    row->cpu_us = t.cpu_seconds * 1e6 / n;
     return 0;
 }
 
@@ -149,7 +130,7 @@ int cmd_run(int argc, char **argv) {
         return 2;
     }
     cbvh_timing_params tp;
-    timing_params(&d, &tp);
+    cbvh_fx_timing(&d, &tp);
     width_row rows[1 + CBVH_N_MAX - CBVH_N_MIN + 1];
     int nrows = 0, rc = check, same_hits = 1;
     for (int n = 0; n <= CBVH_N_MAX; n = n ? n + 1 : CBVH_N_MIN, nrows++) {

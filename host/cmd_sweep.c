@@ -384,7 +384,7 @@ int cmd_sweep(int argc, char **argv) {
     int tty = isatty(2);
     if (tty) o.progress = progress;
     cbvh_timing_params tp;
-    cbvh_sweep_timing(&d, &tp);
+    cbvh_fx_timing(&d, &tp);
     cbvh_sweep_result res;
     if (cbvh_sweep_run(&d, &o, &res, err, sizeof err)) {
         if (tty) fprintf(stderr, "\n");
@@ -397,7 +397,7 @@ int cmd_sweep(int argc, char **argv) {
     /* Relative totals per setting, for the knee and the chart. */
     double tol = (double)knee_pct / 100.0;
     int ncombo = o.nmant * o.nmin_scale;
-    cbvh_fx_stats ftot = cbvh_sweep_total(&res.ref.r);
+    cbvh_fx_stats ftot = cbvh_fx_total(&res.ref.r);
     double fq[SWEEP_NMETRICS];
     cbvh_sweep_per_ray(&ftot, &tp, fq);
     double *relv = calloc((size_t)res.nrows * SWEEP_NMETRICS, sizeof *relv);
@@ -405,7 +405,7 @@ int cmd_sweep(int argc, char **argv) {
     if (!relv || !bits) abort();
     for (int b = 0; b < nb; b++) bits[b] = o.bits_lo + b;
     for (int i = 0; i < res.nrows; i++) {
-        cbvh_fx_stats t = cbvh_sweep_total(&res.rows[i].r);
+        cbvh_fx_stats t = cbvh_fx_total(&res.rows[i].r);
         double p[SWEEP_NMETRICS];
         cbvh_sweep_per_ray(&t, &tp, p);
         for (int m = 0; m < SWEEP_NMETRICS; m++) relv[(size_t)m * res.nrows + i] = rel(p[m], fq[m]);
@@ -530,7 +530,7 @@ int cmd_sweep(int argc, char **argv) {
                     cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
                                           json_costs(&r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
                                                      res.ref.r.node_bytes, &tp));
-            cbvh_fx_stats t = cbvh_sweep_total(&r->r);
+            cbvh_fx_stats t = cbvh_fx_total(&r->r);
             cJSON_AddItemToObject(row, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
             cJSON_AddItemToArray(rows, row);
         }
@@ -576,7 +576,7 @@ int cmd_sweep(int argc, char **argv) {
                 if (d.effect[e].enabled)
                     text_row(name, cbvh_effect_name((cbvh_effect)e), &r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
                              res.ref.r.node_bytes, &tp, same);
-            cbvh_fx_stats t = cbvh_sweep_total(&r->r);
+            cbvh_fx_stats t = cbvh_fx_total(&r->r);
             text_row(name, "total", &t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp, same);
         }
         printf("\nnode memory: float BVH %llu B", (unsigned long long)res.ref.r.node_bytes);

@@ -73,26 +73,6 @@ static per_ray summarize(const cbvh_fx_stats *s, const cbvh_timing_params *tp) {
     return p;
 }
 
-static cbvh_fx_stats total_stats(const cbvh_fx_result *r) {
-    cbvh_fx_stats t = {0};
-    for (int e = 0; e < CBVH_FX_COUNT; e++) {
-        const cbvh_fx_stats *s = &r->fx[e];
-        t.rays += s->rays;
-        t.closest += s->closest;
-        t.any += s->any;
-        t.hits += s->hits;
-        t.rejected += s->rejected;
-        t.st.nodes += s->st.nodes;
-        t.st.box_tests += s->st.box_tests;
-        t.st.tri_tests += s->st.tri_tests;
-        t.st.lines += s->st.lines;
-        t.st.bytes += s->st.bytes;
-        if (s->st.max_stack > t.st.max_stack) t.st.max_stack = s->st.max_stack;
-        t.cpu_seconds += s->cpu_seconds;
-    }
-    return t;
-}
-
 /* A JSON string literal (paths may hold quotes, backslashes, control bytes). */
 static void json_str(const char *s) {
     putchar('"');
@@ -150,7 +130,7 @@ static void json_result(const char *key, const cbvh_scene_desc *d, const cbvh_fx
             json_stats(cbvh_effect_name((cbvh_effect)e), &r->fx[e], tp, !first);
             first = 0;
         }
-    cbvh_fx_stats t = total_stats(r);
+    cbvh_fx_stats t = cbvh_fx_total(r);
     printf("},");
     json_stats("total", &t, tp, 0);
     printf(",\"units\":{\"compressor\":%llu,\"decoder\":%llu,\"ray_box\":%llu,\"ray_triangle\":%llu,\"refit\":%llu}"
@@ -224,15 +204,7 @@ int cmd_trace(int argc, char **argv) {
         return 2;
     }
     cbvh_timing_params tp;
-    cbvh_timing_defaults(&tp);
-    {
-        const cbvh_timing_overrides *o = &d.timing;
-        if (o->box_cycles == o->box_cycles) tp.box_cycles = o->box_cycles; /* not NaN: set in the scene */
-        if (o->tri_cycles == o->tri_cycles) tp.tri_cycles = o->tri_cycles;
-        if (o->fetch_latency == o->fetch_latency) tp.fetch_latency = o->fetch_latency;
-        if (o->dram_bytes_per_cycle == o->dram_bytes_per_cycle) tp.dram_bytes_per_cycle = o->dram_bytes_per_cycle;
-        if (o->clock_mhz == o->clock_mhz) tp.clock_mhz = o->clock_mhz;
-    }
+    cbvh_fx_timing(&d, &tp);
     progress_ctx pc = {"float", 0};
     int tty = isatty(2) && !json;
     cbvh_fx_opts fo = {CBVH_FORMAT_FLOAT, {bits, min_scale}, fmt == CBVH_FORMAT_FLOAT ? mant : 24, spp, NULL,
@@ -306,7 +278,7 @@ int cmd_trace(int argc, char **argv) {
             if (!main_r->fx[e].rays) kind = "-";
             print_row(cbvh_effect_name((cbvh_effect)e), kind, &pm, fmt == CBVH_FORMAT_CBVH ? &pf[e] : NULL);
         }
-        cbvh_fx_stats tf = total_stats(&rf), tm = total_stats(main_r);
+        cbvh_fx_stats tf = cbvh_fx_total(&rf), tm = cbvh_fx_total(main_r);
         pf[CBVH_FX_COUNT] = summarize(&tf, &tp);
         pm = summarize(&tm, &tp);
         print_row("total", "", &pm, fmt == CBVH_FORMAT_CBVH ? &pf[CBVH_FX_COUNT] : NULL);

@@ -11,6 +11,7 @@
 
 #include "cbvh/traverse.h"
 #include "scene_file.h"
+#include "timing_model.h"
 
 typedef enum { CBVH_FORMAT_FLOAT = 0, CBVH_FORMAT_CBVH = 1 } cbvh_accel_format;
 
@@ -71,5 +72,12 @@ typedef struct {
  * bottom-up streaming), and for every frame: refits (frames >= 1), then traces
  * every enabled effect.  0, or -1 with a one-line reason. */
 int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen);
+
+/* Sum over the effects of a result (max_stack = the deepest). */
+cbvh_fx_stats cbvh_fx_total(const cbvh_fx_result *r);
+
+/* Timing-model parameters for a scene: the defaults with the scene file's
+ * overrides (docs/timing_model.md). */
+void cbvh_fx_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp);
 
 #endif

@@ -226,36 +226,6 @@ void cbvh_sweep_free(cbvh_sweep_result *res) {
     memset(res, 0, sizeof *res);
 }
 
-void cbvh_sweep_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp) {
-    cbvh_timing_defaults(tp);
-    const cbvh_timing_overrides *o = &d->timing;
-    if (!isnan(o->box_cycles)) tp->box_cycles = o->box_cycles;
-    if (!isnan(o->tri_cycles)) tp->tri_cycles = o->tri_cycles;
-    if (!isnan(o->fetch_latency)) tp->fetch_latency = o->fetch_latency;
-    if (!isnan(o->dram_bytes_per_cycle)) tp->dram_bytes_per_cycle = o->dram_bytes_per_cycle;
-    if (!isnan(o->clock_mhz)) tp->clock_mhz = o->clock_mhz;
-}
-
-cbvh_fx_stats cbvh_sweep_total(const cbvh_fx_result *r) {
-    cbvh_fx_stats t = {0};
-    for (int e = 0; e < CBVH_FX_COUNT; e++) {
-        const cbvh_fx_stats *s = &r->fx[e];
-        t.rays += s->rays;
-        t.closest += s->closest;
-        t.any += s->any;
-        t.hits += s->hits;
-        t.rejected += s->rejected;
-        t.st.nodes += s->st.nodes;
-        t.st.box_tests += s->st.box_tests;
-        t.st.tri_tests += s->st.tri_tests;
-        t.st.lines += s->st.lines;
-        t.st.bytes += s->st.bytes;
-        if (s->st.max_stack > t.st.max_stack) t.st.max_stack = s->st.max_stack;
-        t.cpu_seconds += s->cpu_seconds;
-    }
-    return t;
-}
-
 void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, double out[SWEEP_NMETRICS]) {
     for (int i = 0; i < SWEEP_NMETRICS; i++) out[i] = 0;
     if (!s->rays) return;

@@ -65,12 +65,6 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
                    size_t errlen);
 void cbvh_sweep_free(cbvh_sweep_result *res);
 
-/* The timing model with the scene's overrides applied. */
-void cbvh_sweep_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp);
-
-/* Sum of the per-effect stats of a run (max_stack = deepest). */
-cbvh_fx_stats cbvh_sweep_total(const cbvh_fx_result *r);
-
 /* Per-ray costs of a set of rays. */
 enum { SWEEP_BOX = 0, SWEEP_TRI, SWEEP_BYTES, SWEEP_MODEL_NS, SWEEP_CPU_US, SWEEP_NMETRICS };
 void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, double out[SWEEP_NMETRICS]);

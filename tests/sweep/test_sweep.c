@@ -29,7 +29,7 @@ static int setup(void **state) {
         fprintf(stderr, "%s\n", err);
         return -1;
     }
-    cbvh_sweep_timing(&scene, &tp);
+    cbvh_fx_timing(&scene, &tp);
     return 0;
 }
 
@@ -41,7 +41,7 @@ static int teardown(void **state) {
 }
 
 static double rel_total(const cbvh_sweep_run_t *r, int metric) {
-    cbvh_fx_stats a = cbvh_sweep_total(&r->r), f = cbvh_sweep_total(&res.ref.r);
+    cbvh_fx_stats a = cbvh_fx_total(&r->r), f = cbvh_fx_total(&res.ref.r);
     double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
     cbvh_sweep_per_ray(&a, &tp, p);
     cbvh_sweep_per_ray(&f, &tp, q);
@@ -67,7 +67,7 @@ static void test_rows(void **state) {
     assert_true(res.ref_rays > 300);
     for (int i = 0; i < res.nrows; i++)
         for (int e = 0; e < CBVH_FX_COUNT; e++) assert_int_equal(res.rows[i].r.fx[e].rays, res.ref.r.fx[e].rays);
-    assert_int_equal(cbvh_sweep_total(&res.ref.r).rays, res.ref_rays);
+    assert_int_equal(cbvh_fx_total(&res.ref.r).rays, res.ref_rays);
     assert_int_equal(res.ref.r.fx[CBVH_FX_MIRROR].rays, 0); /* not in the scene */
     assert_true(res.ref.r.fx[CBVH_FX_AMBIENT_OCCLUSION].rays > 0);
 }
