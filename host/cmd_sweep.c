@@ -2,7 +2,8 @@
  * float BVH and every CBVH setting trace the same rays in one run; costs are
  * printed relative to the float BVH, a chart and heat maps go to --out, and
  * every setting must return the float BVH's hits (exit 1 naming the first
- * differing ray otherwise). */
+ * differing ray otherwise).  --formats cbvh,qbvh adds the QBVH as one more
+ * row, checked the same way. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,7 +23,7 @@
 static void usage(FILE *f) {
     fprintf(f,
             "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
-            "                        [--out DIR] [--heatmap SETTING...] [--knee PCT]\n"
+            "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,qbvh]]\n"
             "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
             "  setting N x M x E, on the same rays, and prints per setting and effect: box and triangle\n"
             "  tests, bytes per ray, node memory, modelled time and CPU time, each relative to the float\n"
@@ -33,9 +34,11 @@ static void usage(FILE *f) {
             "  --min-scale E...  minimum grid scale, -126..126 (default %d)\n"
             "  --spp K           camera samples per pixel, 1..1024 (default: the scene's)\n"
             "  --out DIR         where the chart and heat maps go (default sweep-<scene name>)\n"
-            "  --heatmap S...    settings to draw box tests per pixel for: float, N, or N:M:E\n"
-            "                    (default float 3 6 10, those in range; N uses the first M and E)\n"
+            "  --heatmap S...    settings to draw box tests per pixel for: float, qbvh, N, or N:M:E\n"
+            "                    (default float 3 6 10, those in range, and qbvh if traced; N uses the first M, E)\n"
             "  --knee PCT        knee tolerance in percent, 0..1000 (default 10)\n"
+            "  --formats F,...   formats compared with the float BVH: cbvh (default; always), qbvh (one more\n"
+            "                    row: the 4-ary QBVH with the compressed stack, docs/qbvh.md, at the first M)\n"
             "  --json            machine-readable output on stdout\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
 }
@@ -93,7 +96,7 @@ static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, l
 }
 
 typedef struct {
-    int is_float;
+    int is_float, is_qbvh;
     int bits, mant, min_scale; /* mant/min_scale < -1000: the first of the lists */
     int explicit_all;
 } heat_spec;
@@ -102,6 +105,10 @@ static int parse_heat(const char *s, heat_spec *h) {
     memset(h, 0, sizeof *h);
     if (strcmp(s, "float") == 0) {
         h->is_float = 1;
+        return 0;
+    }
+    if (strcmp(s, "qbvh") == 0) {
+        h->is_qbvh = 1;
         return 0;
     }
     char buf[64], *p[3];
@@ -290,13 +297,14 @@ int cmd_sweep(int argc, char **argv) {
             heat_given = 1;
             int n0 = nheat;
             while (i + 1 < argc && argv[i + 1][0] != '-' && (strcmp(argv[i + 1], "float") == 0 ||
+                                                              strcmp(argv[i + 1], "qbvh") == 0 ||
                                                               (argv[i + 1][0] >= '0' && argv[i + 1][0] <= '9'))) {
                 if (nheat == MAX_HEAT) {
                     fprintf(stderr, "cbvh sweep: --heatmap takes at most %d settings\n", MAX_HEAT);
                     return 2;
                 }
                 if (parse_heat(argv[i + 1], &heat[nheat])) {
-                    fprintf(stderr, "cbvh sweep: --heatmap expects float, N or N:M:E (N in %d..%d), got '%s'\n",
+                    fprintf(stderr, "cbvh sweep: --heatmap expects float, qbvh, N or N:M:E (N in %d..%d), got '%s'\n",
                             CBVH_N_MIN, CBVH_N_MAX, argv[i + 1]);
                     return 2;
                 }
@@ -304,10 +312,28 @@ int cmd_sweep(int argc, char **argv) {
                 i++;
             }
             if (nheat == n0) {
-                fprintf(stderr, "cbvh sweep: --heatmap expects float, N or N:M:E (N in %d..%d), got '%s'\n", CBVH_N_MIN,
-                        CBVH_N_MAX, i + 1 < argc ? argv[i + 1] : "");
+                fprintf(stderr, "cbvh sweep: --heatmap expects float, qbvh, N or N:M:E (N in %d..%d), got '%s'\n",
+                        CBVH_N_MIN, CBVH_N_MAX, i + 1 < argc ? argv[i + 1] : "");
                 return 2;
             }
+        } else if (strcmp(a, "--formats") == 0) {
+            const char *v = i + 1 < argc ? argv[++i] : "";
+            char buf[64];
+            size_t len = strlen(v);
+            int cb = 0, qb = 0, bad = len >= sizeof buf || !*v;
+            if (!bad) memcpy(buf, v, len + 1);
+            for (char *t = strtok(buf, ","); t && !bad; t = strtok(NULL, ","))
+                if (strcmp(t, "cbvh") == 0)
+                    cb = 1;
+                else if (strcmp(t, "qbvh") == 0)
+                    qb = 1;
+                else
+                    bad = 1;
+            if (bad || !cb) {
+                fprintf(stderr, "cbvh sweep: --formats expects cbvh or cbvh,qbvh, got '%s'\n", v);
+                return 2;
+            }
+            o.qbvh = qb;
         } else if (strcmp(a, "--test-corrupt") == 0) {
             /* Test hook (docs/sweep.md): SETTING_INDEX:RAY_INDEX. */
             corrupt = i + 1 < argc ? argv[++i] : "";
@@ -341,11 +367,19 @@ int cmd_sweep(int argc, char **argv) {
         static const int def[] = {3, 6, 10};
         for (int k = 0; k < 3; k++)
             if (def[k] >= o.bits_lo && def[k] <= o.bits_hi) heat[nheat++] = (heat_spec){.bits = def[k]};
+        if (o.qbvh) heat[nheat++] = (heat_spec){.is_qbvh = 1};
     }
     /* Every heat-map setting must be one the sweep traces. */
     for (int h = 0; h < nheat; h++) {
         heat_spec *s = &heat[h];
         if (s->is_float) continue;
+        if (s->is_qbvh) {
+            if (!o.qbvh) {
+                fprintf(stderr, "cbvh sweep: --heatmap qbvh needs --formats cbvh,qbvh\n");
+                return 2;
+            }
+            continue;
+        }
         if (!s->explicit_all) {
             s->mant = o.mant[0];
             s->min_scale = o.min_scale[0];
@@ -371,9 +405,9 @@ int cmd_sweep(int argc, char **argv) {
         return 2;
     }
     int nb = o.bits_hi - o.bits_lo + 1;
-    if (o.corrupt_setting >= nb * o.nmant * o.nmin_scale) {
+    if (o.corrupt_setting >= nb * o.nmant * o.nmin_scale + o.qbvh) {
         fprintf(stderr, "cbvh sweep: --test-corrupt setting %d: the sweep has %d settings\n", o.corrupt_setting,
-                nb * o.nmant * o.nmin_scale);
+                nb * o.nmant * o.nmin_scale + o.qbvh);
         cbvh_scene_desc_free(&d);
         return 2;
     }
@@ -450,8 +484,8 @@ int cmd_sweep(int argc, char **argv) {
     double vmax = 0;
     size_t npx = (size_t)res.width * (size_t)res.height;
     for (int h = 0; h < nheat; h++) {
-        hr[h] = &res.ref;
-        if (!heat[h].is_float)
+        hr[h] = heat[h].is_qbvh ? &res.qbvh : &res.ref;
+        if (!heat[h].is_float && !heat[h].is_qbvh)
             for (int i = 0; i < res.nrows; i++)
                 if (res.rows[i].s.bits == heat[h].bits && res.rows[i].s.mant == heat[h].mant &&
                     res.rows[i].s.min_scale == heat[h].min_scale)
@@ -464,6 +498,8 @@ int cmd_sweep(int argc, char **argv) {
     for (int h = 0; h < nheat; h++) {
         if (heat[h].is_float)
             snprintf(path, sizeof path, "%s/heat-float.png", outdir);
+        else if (heat[h].is_qbvh)
+            snprintf(path, sizeof path, "%s/heat-qbvh.png", outdir);
         else if (heat[h].explicit_all)
             snprintf(path, sizeof path, "%s/heat-N%d-M%d-E%d.png", outdir, heat[h].bits, heat[h].mant,
                      heat[h].min_scale);
@@ -489,6 +525,7 @@ int cmd_sweep(int argc, char **argv) {
             first_bad = i;
             break;
         }
+    if (first_bad < 0 && res.have_qbvh && !res.qbvh.same) first_bad = res.nrows;
     static const char *knee_keys[4] = {"box_tests", "tri_tests", "bytes", "model_time"};
     if (json) {
         cJSON *root = cJSON_CreateObject();
@@ -534,6 +571,23 @@ int cmd_sweep(int argc, char **argv) {
             cJSON_AddItemToObject(row, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
             cJSON_AddItemToArray(rows, row);
         }
+        if (res.have_qbvh) {
+            const cbvh_sweep_run_t *r = &res.qbvh;
+            cJSON *qj = cJSON_AddObjectToObject(root, "qbvh");
+            cJSON_AddNumberToObject(qj, "mant", r->s.mant);
+            cJSON_AddNumberToObject(qj, "node_bytes", (double)r->r.node_bytes);
+            cJSON_AddNumberToObject(qj, "qbvh_stack", (double)r->r.units.qbvh_stack);
+            cJSON_AddBoolToObject(qj, "same_hits", r->same);
+            if (!r->same) cJSON_AddStringToObject(qj, "first_difference", r->why);
+            cJSON *ef = cJSON_AddObjectToObject(qj, "effects");
+            for (int e = 0; e < CBVH_FX_COUNT; e++)
+                if (d.effect[e].enabled)
+                    cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
+                                          json_costs(&r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
+                                                     res.ref.r.node_bytes, &tp));
+            cbvh_fx_stats t = cbvh_fx_total(&r->r);
+            cJSON_AddItemToObject(qj, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
+        }
         cJSON *kn = cJSON_AddArrayToObject(root, "knee");
         for (int c = 0; c < ncombo; c++) {
             cJSON *k = cJSON_CreateObject();
@@ -565,10 +619,12 @@ int cmd_sweep(int argc, char **argv) {
         printf("%-16s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
                "relative to the float BVH ----------------------------");
         char name[48];
-        for (int i = -1; i < res.nrows; i++) {
-            const cbvh_sweep_run_t *r = i < 0 ? &res.ref : &res.rows[i];
+        for (int i = -1; i < res.nrows + res.have_qbvh; i++) {
+            const cbvh_sweep_run_t *r = i < 0 ? &res.ref : i == res.nrows ? &res.qbvh : &res.rows[i];
             if (i < 0)
                 snprintf(name, sizeof name, "float");
+            else if (i == res.nrows)
+                snprintf(name, sizeof name, "qbvh M=%d", r->s.mant);
             else
                 snprintf(name, sizeof name, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
             const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
@@ -581,6 +637,7 @@ int cmd_sweep(int argc, char **argv) {
         }
         printf("\nnode memory: float BVH %llu B", (unsigned long long)res.ref.r.node_bytes);
         for (int b = 0; b < nb; b++) printf(", N=%d %llu B", res.rows[b].s.bits, (unsigned long long)res.rows[b].r.node_bytes);
+        if (res.have_qbvh) printf(", qbvh %llu B", (unsigned long long)res.qbvh.r.node_bytes);
         printf("\n");
         printf("knee = smallest N from which every finer N costs at most %ld%% more than N=%d (totals over effects):\n",
                knee_pct, o.bits_hi);
@@ -599,18 +656,24 @@ int cmd_sweep(int argc, char **argv) {
                            relv[(size_t)SWEEP_BOX * res.nrows + c * nb + b],
                            relv[(size_t)SWEEP_TRI * res.nrows + c * nb + b]);
         if (res.all_same)
-            printf("hits: all %d settings return the float BVH's hits on all %llu rays (same triangle and t bits; no "
+            printf("hits: all %d settings%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
                    "false misses) and render the same %dx%d image\n",
-                   res.nrows, (unsigned long long)res.ref_rays, res.width, res.height);
-        else
+                   res.nrows, res.have_qbvh ? " and the QBVH" : "", (unsigned long long)res.ref_rays, res.width,
+                   res.height);
+        else {
             for (int i = 0; i < res.nrows; i++)
                 if (!res.rows[i].same)
                     printf("hits: N=%d M=%d E=%d DIFFERENT from the float BVH: %s\n", res.rows[i].s.bits,
                            res.rows[i].s.mant, res.rows[i].s.min_scale, res.rows[i].why);
+            if (res.have_qbvh && !res.qbvh.same)
+                printf("hits: qbvh M=%d DIFFERENT from the float BVH: %s\n", res.qbvh.s.mant, res.qbvh.why);
+        }
         printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all\n", used_max);
         for (int k = 0; k < nwritten; k++) printf("wrote %s\n", written[k]);
     }
-    if (first_bad >= 0) {
+    if (first_bad == res.nrows)
+        fprintf(stderr, "cbvh sweep: qbvh M=%d differs from the float BVH: %s\n", res.qbvh.s.mant, res.qbvh.why);
+    else if (first_bad >= 0) {
         const cbvh_sweep_run_t *r = &res.rows[first_bad];
         fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits, r->s.mant,
                 r->s.min_scale, r->why);

@@ -1,5 +1,5 @@
 /* cbvh trace SCENE: trace only the rays a scene's effects call for, on the
- * float BVH and/or the CBVH, and report the cost per effect with the timing
+ * float BVH and/or the CBVH or QBVH, and report the cost per effect with the timing
  * model (docs/scenes.md, docs/timing_model.md). */
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,16 +13,17 @@
 
 static void usage(FILE *f) {
     fprintf(f,
-            "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format float|cbvh] [--json]\n"
+            "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format float|cbvh|qbvh] [--json]\n"
             "                        [--spp K]\n"
             "  Traces the rays the scene file's effects call for (docs/scenes.md) and prints, per effect:\n"
             "  rays, box/triangle tests, nodes and bytes per ray, deepest stack, modelled time per ray\n"
-            "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default) also\n"
-            "  each relative to the float BVH on the same rays, and a units-active line.\n"
+            "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default) or qbvh\n"
+            "  also each relative to the float BVH on the same rays, and a units-active line.\n"
             "  --bits N       CBVH coordinate bits, %d..%d (default 6)\n"
             "  --mant M       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
             "  --min-scale E  minimum grid scale, -126..126 (default %d)\n"
-            "  --format F     float: the float BVH only; cbvh: the CBVH against the float BVH (default)\n"
+            "  --format F     float: the float BVH only; cbvh: the CBVH against the float BVH (default);\n"
+            "                 qbvh: the QBVH (4-ary, compressed 32-bit stack, docs/qbvh.md) against it\n"
             "  --spp K        camera samples per pixel, 1..1024 (default: the scene's camera.spp)\n"
             "  --json         machine-readable output\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
@@ -133,23 +134,25 @@ static void json_result(const char *key, const cbvh_scene_desc *d, const cbvh_fx
     cbvh_fx_stats t = cbvh_fx_total(r);
     printf("},");
     json_stats("total", &t, tp, 0);
-    printf(",\"units\":{\"compressor\":%llu,\"decoder\":%llu,\"ray_box\":%llu,\"ray_triangle\":%llu,\"refit\":%llu}"
-           ",\"hit_digest\":\"%016llx\"}",
+    printf(",\"units\":{\"compressor\":%llu,\"decoder\":%llu,\"ray_box\":%llu,\"ray_triangle\":%llu,\"refit\":%llu,"
+           "\"qbvh_stack\":%llu},\"qbvh_stack_pushes\":%llu,\"qbvh_stack_pops\":%llu,\"hit_digest\":\"%016llx\"}",
            (unsigned long long)r->units.compressor, (unsigned long long)r->units.decoder,
            (unsigned long long)r->units.ray_box, (unsigned long long)r->units.ray_triangle,
-           (unsigned long long)r->units.refit, (unsigned long long)r->hit_digest);
+           (unsigned long long)r->units.refit, (unsigned long long)r->units.qbvh_stack,
+           (unsigned long long)t.st.qstack_pushes, (unsigned long long)t.st.qstack_pops,
+           (unsigned long long)r->hit_digest);
 }
 
 static void print_units(const cbvh_unit_activity *u, int animated) {
-    const char *names[] = {"compressor", "decoder", "ray_box", "ray_triangle", "refit"};
-    uint64_t v[] = {u->compressor, u->decoder, u->ray_box, u->ray_triangle, u->refit};
+    const char *names[] = {"compressor", "decoder", "ray_box", "ray_triangle", "refit", "qbvh_stack"};
+    uint64_t v[] = {u->compressor, u->decoder, u->ray_box, u->ray_triangle, u->refit, u->qbvh_stack};
     printf("units active:");
     int any = 0;
-    for (int i = 0; i < 5; i++)
+    for (int i = 0; i < 6; i++)
         if (v[i]) printf("%s %s %llu", any++ ? "," : "", names[i], (unsigned long long)v[i]);
     printf("  | idle:");
     any = 0;
-    for (int i = 0; i < 5; i++)
+    for (int i = 0; i < 6; i++)
         if (!v[i]) printf("%s %s", any++ ? "," : "", names[i]);
     if (!any) printf(" none");
     printf("%s\n", animated ? "" : "  (static scene: no refit)");
@@ -180,8 +183,10 @@ int cmd_trace(int argc, char **argv) {
                 fmt = CBVH_FORMAT_FLOAT;
             else if (strcmp(f, "cbvh") == 0)
                 fmt = CBVH_FORMAT_CBVH;
+            else if (strcmp(f, "qbvh") == 0)
+                fmt = CBVH_FORMAT_QBVH;
             else {
-                fprintf(stderr, "cbvh trace: --format expects float or cbvh, got '%s'\n", f);
+                fprintf(stderr, "cbvh trace: --format expects float, cbvh or qbvh, got '%s'\n", f);
                 return 2;
             }
         } else if (a[0] == '-' && a[1]) {
@@ -218,9 +223,10 @@ int cmd_trace(int argc, char **argv) {
         return 1;
     }
     const cbvh_fx_result *main_r = &rf;
-    if (fmt == CBVH_FORMAT_CBVH) {
-        pc.label = "cbvh";
-        fo.format = CBVH_FORMAT_CBVH;
+    int cmp = fmt != CBVH_FORMAT_FLOAT; /* a format compared against the float BVH */
+    if (cmp) {
+        pc.label = cbvh_format_name(fmt);
+        fo.format = fmt;
         fo.mant = mant;
         if (cbvh_fx_run(&d, &fo, &rc, err, sizeof err)) {
             if (pc.last_row) fprintf(stderr, "\n");
@@ -229,7 +235,7 @@ int cmd_trace(int argc, char **argv) {
             return 1;
         }
         main_r = &rc;
-        if (rc.hit_digest != rf.hit_digest) status = 1; /* CBVH must return the float BVH's hits */
+        if (rc.hit_digest != rf.hit_digest) status = 1; /* CBVH / QBVH must return the float BVH's hits */
     }
     if (pc.last_row) fprintf(stderr, "\r%60s\r", "");
     int spp_used = spp ? spp : d.camera.spp;
@@ -244,11 +250,11 @@ int cmd_trace(int argc, char **argv) {
                "\"timing\":{\"box_cycles\":%g,\"tri_cycles\":%g,\"fetch_latency\":%g,\"dram_bytes_per_cycle\":%g,"
                "\"clock_mhz\":%g}",
                d.mesh.ntris, rf.frames, cams[d.camera.type], d.camera.width, d.camera.height,
-               spp_used, fmt == CBVH_FORMAT_CBVH ? "cbvh" : "float", bits, mant, min_scale, tp.box_cycles,
+               spp_used, cbvh_format_name(fmt), bits, mant, min_scale, tp.box_cycles,
                tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
         json_result("float", &d, &rf, &tp);
-        if (fmt == CBVH_FORMAT_CBVH) {
-            json_result("cbvh", &d, &rc, &tp);
+        if (cmp) {
+            json_result(cbvh_format_name(fmt), &d, &rc, &tp);
             printf(",\"same_hits\":%s", status ? "false" : "true");
         }
         printf("}\n");
@@ -260,6 +266,10 @@ int cmd_trace(int argc, char **argv) {
             printf("format cbvh: N=%d, M=%d, min scale %d, modulo; node memory %llu B (float BVH %llu B, x%.3f)\n", bits,
                    mant, min_scale, (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
                    ratio((double)rc.node_bytes, (double)rf.node_bytes));
+        else if (fmt == CBVH_FORMAT_QBVH)
+            printf("format qbvh: 4-ary, compressed 32-bit stack, M=%d; node memory %llu B (float BVH %llu B, x%.3f)\n",
+                   mant, (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
+                   ratio((double)rc.node_bytes, (double)rf.node_bytes));
         else
             printf("format float: M=%d; node memory %llu B\n", mant, (unsigned long long)rf.node_bytes);
         printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
@@ -267,7 +277,7 @@ int cmd_trace(int argc, char **argv) {
                tp.box_cycles, tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
         printf("%-18s %-7s %9s %8s %7s %8s %8s %5s %9s %8s", "effect", "kind", "rays", "box/ray", "tri/ray",
                "node/ray", "B/ray", "stack", "model ns", "CPU us");
-        if (fmt == CBVH_FORMAT_CBVH) printf("   vs float: box, tri, bytes, model, CPU");
+        if (cmp) printf("   vs float: box, tri, bytes, model, CPU");
         printf("\n");
         per_ray pf[CBVH_FX_COUNT + 1], pm;
         for (int e = 0; e < CBVH_FX_COUNT; e++) {
@@ -276,12 +286,12 @@ int cmd_trace(int argc, char **argv) {
             pm = summarize(&main_r->fx[e], &tp);
             const char *kind = main_r->fx[e].any ? (main_r->fx[e].closest ? "mixed" : "any") : "closest";
             if (!main_r->fx[e].rays) kind = "-";
-            print_row(cbvh_effect_name((cbvh_effect)e), kind, &pm, fmt == CBVH_FORMAT_CBVH ? &pf[e] : NULL);
+            print_row(cbvh_effect_name((cbvh_effect)e), kind, &pm, cmp ? &pf[e] : NULL);
         }
         cbvh_fx_stats tf = cbvh_fx_total(&rf), tm = cbvh_fx_total(main_r);
         pf[CBVH_FX_COUNT] = summarize(&tf, &tp);
         pm = summarize(&tm, &tp);
-        print_row("total", "", &pm, fmt == CBVH_FORMAT_CBVH ? &pf[CBVH_FX_COUNT] : NULL);
+        print_row("total", "", &pm, cmp ? &pf[CBVH_FX_COUNT] : NULL);
         int unnamed = 0;
         for (int e = 0; e < CBVH_FX_COUNT; e++)
             if (!d.effect[e].enabled) {
@@ -295,12 +305,22 @@ int cmd_trace(int argc, char **argv) {
         if (tm.rejected) printf("rays rejected by a unit (no hit): %llu\n", (unsigned long long)tm.rejected);
         print_units(&main_r->units, main_r->frames > 1);
         printf("build%s: %.3f s CPU%s\n", main_r->frames > 1 ? " + refits" : "", main_r->build_cpu_seconds,
-               fmt == CBVH_FORMAT_CBVH ? " (CBVH: SAH build + bottom-up streaming compression)" : " (SAH build)");
-        if (fmt == CBVH_FORMAT_CBVH)
+               fmt == CBVH_FORMAT_CBVH   ? " (CBVH: SAH build + bottom-up streaming compression)"
+               : fmt == CBVH_FORMAT_QBVH ? (main_r->frames > 1 ? " (QBVH: SAH build + 4-ary collapse; refits: the QBVH's "
+                                                                   "own boxes bottom-up, topology kept)"
+                                                                 : " (QBVH: SAH build + 4-ary collapse)")
+                                         : " (SAH build)");
+        if (fmt == CBVH_FORMAT_QBVH)
+            printf("qbvh stack unit: %llu sort+push, %llu pop operations; deepest stack %u entries (float BVH %u)\n",
+                   (unsigned long long)tm.st.qstack_pushes, (unsigned long long)tm.st.qstack_pops, tm.st.max_stack,
+                   tf.st.max_stack);
+        if (cmp)
             printf("hits: %s the float BVH's (digest %016llx)\n", status ? "DIFFERENT FROM" : "identical to",
                    (unsigned long long)rc.hit_digest);
     }
-    if (status) fprintf(stderr, "cbvh trace: CBVH hits differ from the float BVH (a traversal bug)\n");
+    if (status)
+        fprintf(stderr, "cbvh trace: %s hits differ from the float BVH (a traversal bug)\n",
+                fmt == CBVH_FORMAT_QBVH ? "QBVH" : "CBVH");
     cbvh_scene_desc_free(&d);
     return status;
 }

@@ -69,7 +69,7 @@ static void cosine_dir(rng *r, const float n[3], float out[3]) {
     for (int i = 0; i < 3; i++) out[i] = x * t[i] + y * b[i] + z * n[i];
 }
 
-/* ---- the accelerator: float BVH or CBVH ---- */
+/* ---- the accelerator: float BVH, CBVH or QBVH ---- */
 typedef struct {
     const cbvh_scene_desc *d;
     const cbvh_fx_opts *o;
@@ -77,6 +77,8 @@ typedef struct {
     cbvh_bvh bvh;
     cbvh_tree tree;
     int have_tree;
+    cbvh_qbvh qbvh;
+    int have_qbvh;
     cbvh_tri *tris; /* current frame */
     float eps;      /* secondary-ray origin offset along the normal */
     int frame;
@@ -100,8 +102,9 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
     r.tmax = isinf(tmax) ? CBVH_F32_POS_INF : fbits(tmax);
     cbvh_trav_stats st = {0};
     double t0 = cpu_now();
-    int rc = T->o->format == CBVH_FORMAT_CBVH
-                 ? cbvh_trace_cbvh(&T->tree, T->tris, &r, T->o->mant, mode, hit, &st)
+    int rc = T->o->format == CBVH_FORMAT_CBVH ? cbvh_trace_cbvh(&T->tree, T->tris, &r, T->o->mant, mode, hit, &st)
+             : T->o->format == CBVH_FORMAT_QBVH
+                 ? cbvh_trace_qbvh(&T->qbvh, T->tris, &r, T->o->mant, mode, CBVH_QSTACK_COMPRESSED, hit, &st)
                  : cbvh_trace_bvh(&T->bvh, T->tris, &r, T->o->mant, mode, hit, &st);
     double t1 = cpu_now();
     cbvh_fx_stats *s = &T->res->fx[fx];
@@ -122,10 +125,13 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
     s->st.lines += st.lines;
     s->st.bytes += st.bytes;
     if (st.max_stack > s->st.max_stack) s->st.max_stack = st.max_stack;
+    s->st.qstack_pushes += st.qstack_pushes;
+    s->st.qstack_pops += st.qstack_pops;
     cbvh_unit_activity *u = &T->res->units;
     u->ray_box += st.box_tests;
     u->ray_triangle += st.tri_tests;
     if (T->o->format == CBVH_FORMAT_CBVH) u->decoder += 6 * st.nodes;
+    u->qbvh_stack += st.qstack_pushes + st.qstack_pops;
     /* Closest hit: triangle and t are defined (same on every format); any hit: only whether. */
     uint64_t h = T->res->hit_digest ^
                  (!hit->hit ? 0xFFFFFFFFFFFFFFFFu : mode == CBVH_TRAV_ANY ? 1 : ((uint64_t)hit->prim << 32 | hit->t));
@@ -277,6 +283,47 @@ static int compress(tracer *T, const cbvh_tri *refit, char *err, size_t errlen) 
     return 0;
 }
 
+/* Refit of the QBVH's own boxes, keeping its topology: nodes are laid out
+ * breadth-first (children after their parent), so one pass from the last
+ * node to the root sees every child before its parent.  Returns the number
+ * of node boxes recomputed. */
+static uint64_t qbvh_refit(cbvh_qbvh *q, const cbvh_tri *tris) {
+    for (uint32_t i = q->nnodes; i-- > 0;) {
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        uint32_t c = q->count[i], f = q->first[i];
+        if (c & CBVH_QBVH_LEAF) {
+            for (uint32_t k = 0; k < (c & ~CBVH_QBVH_LEAF); k++)
+                for (int v = 0; v < 3; v++)
+                    for (int a = 0; a < 3; a++) {
+                        float x = tris[q->prims[f + k]].v[v][a];
+                        lo[a] = fminf(lo[a], x);
+                        hi[a] = fmaxf(hi[a], x);
+                    }
+        } else
+            for (uint32_t k = 0; k < c; k++)
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = fminf(lo[a], q->bmin[f + k][a]);
+                    hi[a] = fmaxf(hi[a], q->bmax[f + k][a]);
+                }
+        for (int a = 0; a < 3; a++) {
+            q->bmin[i][a] = lo[a];
+            q->bmax[i][a] = hi[a];
+        }
+    }
+    return q->nnodes;
+}
+
+/* The refit relies on children lying after their parent (breadth-first). */
+static int qbvh_children_after_parent(const cbvh_qbvh *q) {
+    for (uint32_t i = 0; i < q->nnodes; i++)
+        if (!(q->count[i] & CBVH_QBVH_LEAF) && q->first[i] <= i) return 0;
+    return 1;
+}
+
+const char *cbvh_format_name(cbvh_accel_format f) {
+    return f == CBVH_FORMAT_CBVH ? "cbvh" : f == CBVH_FORMAT_QBVH ? "qbvh" : "float";
+}
+
 int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
     if (o->mant < CBVH_MANT_MIN || o->mant > CBVH_MANT_MAX) {
@@ -310,6 +357,15 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     if (o->format == CBVH_FORMAT_CBVH) {
         if (compress(&T, NULL, err, errlen)) goto out;
         r->node_bytes = cbvh_tree_bytes(&T.tree);
+    } else if (o->format == CBVH_FORMAT_QBVH) {
+        if (cbvh_qbvh_from_bvh(&T.bvh, &T.qbvh, err, errlen)) goto out;
+        T.have_qbvh = 1;
+        if (cbvh_qbvh_stack_check(&T.qbvh, CBVH_QSTACK_COMPRESSED, err, errlen)) goto out;
+        if (!qbvh_children_after_parent(&T.qbvh)) {
+            snprintf(err, errlen, "qbvh: a child group lies before its parent (layout not breadth-first)");
+            goto out;
+        }
+        r->node_bytes = cbvh_qbvh_node_bytes(&T.qbvh) + (uint64_t)T.qbvh.nprims * 4u;
     } else
         r->node_bytes = cbvh_bvh_bytes(&T.bvh);
     r->build_cpu_seconds = cpu_now() - b0;
@@ -320,10 +376,14 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
             double t0 = cpu_now();
             if (o->format == CBVH_FORMAT_CBVH) {
                 if (compress(&T, T.tris, err, errlen)) goto out; /* streaming refit */
-            } else
+                r->units.refit += T.bvh.nnodes;
+            } else if (o->format == CBVH_FORMAT_QBVH)
+                r->units.refit += qbvh_refit(&T.qbvh, T.tris); /* the QBVH's boxes, same topology */
+            else {
                 cbvh_bvh_refit(&T.bvh, T.tris);
+                r->units.refit += T.bvh.nnodes;
+            }
             r->build_cpu_seconds += cpu_now() - t0;
-            r->units.refit += T.bvh.nnodes;
             r->refits++;
         }
         trace_frame(&T);
@@ -331,6 +391,7 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     rc = 0;
 out:
     if (T.have_tree) cbvh_tree_free(&T.tree);
+    if (T.have_qbvh) cbvh_qbvh_free(&T.qbvh);
     cbvh_bvh_free(&T.bvh);
     free(T.tris);
     return rc;
@@ -351,6 +412,8 @@ cbvh_fx_stats cbvh_fx_total(const cbvh_fx_result *r) {
         t.st.lines += s->st.lines;
         t.st.bytes += s->st.bytes;
         if (s->st.max_stack > t.st.max_stack) t.st.max_stack = s->st.max_stack;
+        t.st.qstack_pushes += s->st.qstack_pushes;
+        t.st.qstack_pops += s->st.qstack_pops;
         t.cpu_seconds += s->cpu_seconds;
     }
     return t;

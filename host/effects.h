@@ -1,6 +1,6 @@
 /* Effects -> rays (docs/scenes.md §Effects): generate only the rays the
  * scene's effects call for, trace them with the units the chosen format needs
- * (float BVH or CBVH), and count the cost per effect and the activity of every
+ * (float BVH, CBVH or QBVH), and count the cost per effect and the activity of every
  * unit.  Sampling is deterministic (seeded per pixel and sample), so the float
  * BVH and the CBVH see the same rays and, since their hits are identical
  * (docs/traversal.md §5), spawn the same secondary rays. */
@@ -9,11 +9,17 @@
 
 #include <stdint.h>
 
+#include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 #include "scene_file.h"
 #include "timing_model.h"
 
-typedef enum { CBVH_FORMAT_FLOAT = 0, CBVH_FORMAT_CBVH = 1 } cbvh_accel_format;
+/* QBVH: the same binned-SAH float BVH collapsed to 4-ary (docs/qbvh.md),
+ * traversed with the compressed 32-bit stack. */
+typedef enum { CBVH_FORMAT_FLOAT = 0, CBVH_FORMAT_CBVH = 1, CBVH_FORMAT_QBVH = 2 } cbvh_accel_format;
+
+/* "float", "cbvh", "qbvh". */
+const char *cbvh_format_name(cbvh_accel_format f);
 
 /* One traced ray, as the observer sees it. */
 typedef struct {
@@ -54,6 +60,7 @@ typedef struct {
     uint64_t ray_box;      /* ray-box tests */
     uint64_t ray_triangle; /* ray-triangle tests */
     uint64_t refit;        /* node boxes recomputed by refits (animated scenes only) */
+    uint64_t qbvh_stack;   /* QBVH stack unit operations: sort + push (one per inner node visited) and pops */
 } cbvh_unit_activity;
 
 typedef struct {
@@ -69,8 +76,10 @@ typedef struct {
 } cbvh_fx_result;
 
 /* Builds the float BVH (binned SAH) of frame 0, compresses it (format cbvh,
- * bottom-up streaming), and for every frame: refits (frames >= 1), then traces
- * every enabled effect.  0, or -1 with a one-line reason. */
+ * bottom-up streaming) or collapses it to a QBVH (format qbvh), and for every
+ * frame: refits (frames >= 1; the QBVH's own boxes are refitted bottom-up,
+ * its topology kept), then traces every enabled effect.  0, or -1 with a
+ * one-line reason. */
 int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen);
 
 /* Sum over the effects of a result (max_stack = the deepest). */

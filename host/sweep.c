@@ -138,6 +138,28 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, c
     return rc;
 }
 
+/* After a run: the same number of rays as the reference and the same image. */
+static void check_totals(const sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_sweep_result *res) {
+    if (run->same && c->n != c->nrec) {
+        run->same = 0;
+        run->bad_ray = c->n;
+        snprintf(run->why, sizeof run->why, "traced %llu rays, the float BVH %llu", (unsigned long long)c->n,
+                 (unsigned long long)c->nrec);
+    }
+    /* The rendered image, pixel by pixel (implied by the ray check; checked anyway). */
+    size_t npx = (size_t)res->width * (size_t)res->height;
+    for (size_t p = 0; run->same && p < npx; p++)
+        if (run->image[p] != res->ref.image[p]) {
+            run->same = 0;
+            run->bad_px = (int)(p % (size_t)res->width);
+            run->bad_py = (int)(p / (size_t)res->width);
+            run->bad_fx = CBVH_FX_PRIMARY;
+            snprintf(run->why, sizeof run->why, "image pixel %d,%d: grey %u, float BVH %u", run->bad_px, run->bad_py,
+                     run->image[p], res->ref.image[p]);
+        }
+    if (!run->same) res->all_same = 0;
+}
+
 int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_sweep_result *res, char *err,
                    size_t errlen) {
     memset(res, 0, sizeof *res);
@@ -174,7 +196,7 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
 
     cbvh_tri *tris0 = xcalloc(d->mesh.ntris, sizeof *tris0);
     cbvh_scene_desc_frame(d, 0, tris0);
-    sweep_ctx c = {.d = d, .o = o, .tris0 = tris0, .setting = -1, .nsettings = res->nrows, .label = "float",
+    sweep_ctx c = {.d = d, .o = o, .tris0 = tris0, .setting = -1, .nsettings = res->nrows + (o->qbvh != 0), .label = "float",
                    .spp = res->spp};
     int rc = -1;
     res->ref.s = (cbvh_sweep_setting){0, CBVH_MANT_MAX, o->min_scale[0]};
@@ -188,24 +210,17 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
         c.setting = i;
         c.label = label;
         if (run_one(&c, run, CBVH_FORMAT_CBVH, err, errlen)) goto out;
-        if (run->same && c.n != c.nrec) {
-            run->same = 0;
-            run->bad_ray = c.n;
-            snprintf(run->why, sizeof run->why, "traced %llu rays, the float BVH %llu", (unsigned long long)c.n,
-                     (unsigned long long)c.nrec);
-        }
-        /* The rendered image, pixel by pixel (implied by the ray check; checked anyway). */
-        size_t npx = (size_t)res->width * (size_t)res->height;
-        for (size_t p = 0; run->same && p < npx; p++)
-            if (run->image[p] != res->ref.image[p]) {
-                run->same = 0;
-                run->bad_px = (int)(p % (size_t)res->width);
-                run->bad_py = (int)(p / (size_t)res->width);
-                run->bad_fx = CBVH_FX_PRIMARY;
-                snprintf(run->why, sizeof run->why, "image pixel %d,%d: grey %u, float BVH %u", run->bad_px,
-                         run->bad_py, run->image[p], res->ref.image[p]);
-            }
-        if (!run->same) res->all_same = 0;
+        check_totals(&c, run, res);
+    }
+    if (o->qbvh) {
+        cbvh_sweep_run_t *run = &res->qbvh;
+        res->have_qbvh = 1;
+        run->s = (cbvh_sweep_setting){0, o->mant[0], o->min_scale[0]};
+        snprintf(label, sizeof label, "qbvh M=%d", run->s.mant);
+        c.setting = res->nrows;
+        c.label = label;
+        if (run_one(&c, run, CBVH_FORMAT_QBVH, err, errlen)) goto out;
+        check_totals(&c, run, res);
     }
     rc = 0;
 out:
@@ -223,6 +238,8 @@ void cbvh_sweep_free(cbvh_sweep_result *res) {
         free(res->rows[i].image);
     }
     free(res->rows);
+    free(res->qbvh.box_px);
+    free(res->qbvh.image);
     memset(res, 0, sizeof *res);
 }
 

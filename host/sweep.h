@@ -3,7 +3,8 @@
  * minimum scale E), on the same rays in one run, and prove every setting
  * returns the float BVH's hits ray by ray (same triangle and t bits for
  * closest-hit rays, same answer for any-hit rays: no false misses) and renders
- * the same image.  The output side (table, JSON, chart, heat maps) is
+ * the same image.  Optionally the QBVH (docs/qbvh.md) is traced on the same
+ * rays as one more row (it has no N) and checked the same way.  The output side (table, JSON, chart, heat maps) is
  * host/cmd_sweep.c. */
 #ifndef CBVH_HOST_SWEEP_H
 #define CBVH_HOST_SWEEP_H
@@ -28,8 +29,9 @@ typedef struct {
     int mant[CBVH_SWEEP_MAX_LIST], nmant;
     int min_scale[CBVH_SWEEP_MAX_LIST], nmin_scale;
     int spp; /* 0 = the scene's */
-    /* Test hook: pretend setting `corrupt_setting` (index into rows, -1 =
-     * none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
+    int qbvh; /* also trace the QBVH (ray-box unit M = mant[0]): the row after the CBVH settings */
+    /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows =
+     * the QBVH row, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
      * for a closest hit, the opposite answer for an any-hit ray). */
     int corrupt_setting;
     uint64_t corrupt_ray;
@@ -57,7 +59,9 @@ typedef struct {
     cbvh_sweep_run_t ref; /* float BVH */
     cbvh_sweep_run_t *rows; /* nrows CBVH settings: for each M, each E, each N ascending */
     int nrows;
-    int all_same;
+    int have_qbvh;
+    cbvh_sweep_run_t qbvh; /* the QBVH row (s.bits = 0, s.mant = its M) when have_qbvh */
+    int all_same; /* every CBVH setting and the QBVH */
 } cbvh_sweep_result;
 
 /* 0, or -1 with a one-line reason (bad option, build failure). */

@@ -136,6 +136,7 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
             uint8_t order[4];
             int nhit;
             cbvh_qstack_sort(t, mask, order, &nhit);
+            qs.s.qstack_pushes++;
             if (nhit >= 2) {
                 if (head == CBVH_TRAV_STACK) {
                     rc = -1;
@@ -170,6 +171,7 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
         }
         if (go) continue;
         if (head == 0) break;
+        qs.s.qstack_pops++;
         if (kind == CBVH_QSTACK_COMPRESSED) {
             uint32_t next;
             int keep;
@@ -195,5 +197,7 @@ finish:
     st->lines += qs.s.lines;
     st->bytes += qs.s.bytes;
     if (qs.s.max_stack > st->max_stack) st->max_stack = qs.s.max_stack;
+    st->qstack_pushes += qs.s.qstack_pushes;
+    st->qstack_pops += qs.s.qstack_pops;
     return rc;
 }

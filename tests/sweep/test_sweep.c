@@ -1,6 +1,7 @@
 /* cbvh sweep core (host/sweep.c, docs/sweep.md): the rows, the relative
  * costs at the extremes, the ray-by-ray identity check (and that a corrupted
- * setting fails it), the heat-map data and the knee rule. */
+ * setting fails it), the heat-map data and the knee rule; the QBVH row
+ * (--formats cbvh,qbvh). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -171,6 +172,56 @@ static void test_corrupted_anyhit_fails(void **state) {
     cbvh_sweep_free(&r);
 }
 
+/* The QBVH row: traced on the same rays, same hits and image as the float
+ * BVH, its own heat-map data and stack-unit activity; absent by default. */
+static void qbvh_run(int corrupt, uint64_t ray, cbvh_sweep_result *out) {
+    cbvh_sweep_opts o = {.bits_lo = 6, .bits_hi = 6, .mant = {24}, .nmant = 1, .min_scale = {-30},
+                         .nmin_scale = 1, .qbvh = 1, .corrupt_setting = corrupt, .corrupt_ray = ray};
+    char err[256];
+    assert_int_equal(cbvh_sweep_run(&scene, &o, out, err, sizeof err), 0);
+    assert_int_equal(out->nrows, 1);
+    assert_true(out->have_qbvh);
+    assert_true(out->rows[0].same);
+}
+
+static void test_qbvh_row(void **state) {
+    (void)state;
+    assert_false(res.have_qbvh);
+    cbvh_sweep_result r;
+    qbvh_run(-1, 0, &r);
+    const cbvh_sweep_run_t *q = &r.qbvh;
+    size_t npx = (size_t)r.width * (size_t)r.height;
+    assert_true(q->same);
+    assert_true(r.all_same);
+    assert_int_equal(q->s.bits, 0);
+    assert_int_equal(q->s.mant, 24);
+    assert_int_equal(q->r.hit_digest, r.ref.r.hit_digest);
+    assert_memory_equal(q->image, r.ref.image, npx);
+    cbvh_fx_stats t = cbvh_fx_total(&q->r), f = cbvh_fx_total(&r.ref.r);
+    assert_int_equal(t.rays, f.rays);
+    assert_int_equal(t.hits, f.hits);
+    assert_true(q->r.units.qbvh_stack > 0);
+    assert_int_equal(r.rows[0].r.units.qbvh_stack, 0);
+    assert_int_equal(r.ref.r.units.qbvh_stack, 0);
+    assert_true(q->r.node_bytes < r.ref.r.node_bytes);
+    double sum = 0;
+    for (size_t p = 0; p < npx; p++) sum += q->box_px[p];
+    assert_true(sum == (double)q->r.fx[CBVH_FX_PRIMARY].st.box_tests);
+    cbvh_sweep_free(&r);
+}
+
+static void test_qbvh_corrupted_fails(void **state) {
+    (void)state;
+    uint64_t first = first_hit_ray();
+    cbvh_sweep_result r;
+    qbvh_run(1, first, &r); /* setting index 1 = the row after the CBVH settings: the QBVH */
+    assert_false(r.qbvh.same);
+    assert_false(r.all_same);
+    assert_int_equal(r.qbvh.bad_ray, first);
+    assert_non_null(strstr(r.qbvh.why, "t=0x"));
+    cbvh_sweep_free(&r);
+}
+
 static void test_knee_rule(void **state) {
     (void)state;
     int bits[] = {3, 4, 5, 6};
@@ -212,6 +263,8 @@ int main(void) {
         cmocka_unit_test(test_corrupted_miss_fails),
         cmocka_unit_test(test_corrupted_anyhit_fails),
         cmocka_unit_test(test_corrupted_t_fails),
+        cmocka_unit_test(test_qbvh_row),
+        cmocka_unit_test(test_qbvh_corrupted_fails),
         cmocka_unit_test(test_knee_rule),
         cmocka_unit_test(test_bad_options),
     };

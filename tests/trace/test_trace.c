@@ -6,6 +6,8 @@
  *   - every effect's rays are of the right kind (any-hit shadow rays aimed at
  *     the lights, mirror rays only from mirror surfaces, ...);
  *   - CBVH and float BVH see the same rays and the same hits;
+ *   - so does the QBVH (format qbvh), ray by ray, also after refits; only
+ *     it runs the qbvh_stack unit;
  *   - scene-file errors give the right one-line message;
  *   - the timing model computes what its doc says on a hand-checked example. */
 #include <math.h>
@@ -236,6 +238,126 @@ static void animated_refits(void **state) {
     cbvh_scene_desc_free(&d);
 }
 
+/* ---- QBVH (docs/qbvh.md): the same rays and hits as the float BVH ---- */
+typedef struct {
+    watch w;
+    uint64_t n, cap;
+    uint32_t *rec; /* per ray: effect, hit, prim, t bits (closest) */
+} recorder;
+
+static void record(void *ctx, const cbvh_fx_ray *r) {
+    recorder *c = ctx;
+    on_ray(&c->w, r);
+    if (c->n + 4 > c->cap) {
+        c->cap = c->cap ? 2 * c->cap : 4096;
+        c->rec = realloc(c->rec, c->cap * sizeof *c->rec);
+        assert_non_null(c->rec);
+    }
+    int closest = r->mode == CBVH_TRAV_CLOSEST;
+    c->rec[c->n++] = (uint32_t)r->effect;
+    c->rec[c->n++] = r->hit->hit != 0;
+    c->rec[c->n++] = closest && r->hit->hit ? r->hit->prim : 0;
+    c->rec[c->n++] = closest && r->hit->hit ? r->hit->t : 0;
+}
+
+static void run_recorded(const cbvh_scene_desc *d, cbvh_accel_format f, recorder *c, cbvh_fx_result *r) {
+    memset(c, 0, sizeof *c);
+    c->w.d = d;
+    cbvh_fx_opts o = opts(f);
+    o.on_ray = record;
+    o.ctx = c;
+    run(d, &o, r);
+    assert_int_equal(c->w.bad, 0);
+}
+
+/* Every effect: the QBVH traces the float BVH's rays and returns its hits ray
+ * by ray (triangle and t bits for closest hit, hit/miss for any hit); the
+ * qbvh_stack unit runs only in format qbvh, once per inner node visited plus
+ * once per pop; the compressed stack is never deeper than the binary one. */
+static void qbvh_all_effects(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load(all_fx_scene, &d);
+    static cbvh_fx_result r[3];
+    recorder c[3];
+    const cbvh_accel_format fm[3] = {CBVH_FORMAT_FLOAT, CBVH_FORMAT_CBVH, CBVH_FORMAT_QBVH};
+    for (int f = 0; f < 3; f++) run_recorded(&d, fm[f], &c[f], &r[f]);
+    assert_int_equal(c[2].n, c[0].n);
+    assert_memory_equal(c[2].rec, c[0].rec, c[0].n * sizeof *c[0].rec);
+    assert_int_equal(r[2].hit_digest, r[0].hit_digest);
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        assert_true(r[2].fx[e].rays > 0);
+        assert_int_equal(r[2].fx[e].rays, r[0].fx[e].rays);
+        assert_int_equal(r[2].fx[e].hits, r[0].fx[e].hits);
+        assert_int_equal(r[2].fx[e].st.qstack_pushes, r[2].fx[e].st.nodes);
+        assert_true(r[2].fx[e].st.qstack_pops > 0);
+        assert_true(r[2].fx[e].st.max_stack <= r[0].fx[e].st.max_stack);
+    }
+    cbvh_fx_stats t = cbvh_fx_total(&r[2]);
+    assert_true(r[2].units.qbvh_stack > 0);
+    assert_int_equal(r[2].units.qbvh_stack, t.st.qstack_pushes + t.st.qstack_pops);
+    assert_int_equal(r[2].units.ray_box, t.st.box_tests);
+    assert_int_equal(r[2].units.ray_triangle, t.st.tri_tests);
+    assert_int_equal(r[2].units.compressor + r[2].units.decoder + r[2].units.refit, 0);
+    assert_int_equal(r[0].units.qbvh_stack, 0);
+    assert_int_equal(r[1].units.qbvh_stack, 0);
+    /* The 4-ary tree: fewer nodes than the binary one, so less memory. */
+    assert_true(r[2].node_bytes > 0 && r[2].node_bytes < r[0].node_bytes);
+    for (int f = 0; f < 3; f++) free(c[f].rec);
+    cbvh_scene_desc_free(&d);
+}
+
+/* Effects not named make no QBVH rays (and no stack activity for them). */
+static void qbvh_effects_obeyed(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA ", \"lights\": [{\"type\": \"point\", \"position\": [8, 16, 10]}],"
+         " \"effects\": [\"primary\", \"hard_shadows\"]}",
+         &d);
+    cbvh_fx_result r;
+    recorder c;
+    run_recorded(&d, CBVH_FORMAT_QBVH, &c, &r);
+    assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays, 24 * 18);
+    assert_true(r.fx[CBVH_FX_HARD_SHADOWS].rays > 0);
+    assert_int_equal(r.fx[CBVH_FX_HARD_SHADOWS].closest, 0);
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        if (e == CBVH_FX_PRIMARY || e == CBVH_FX_HARD_SHADOWS) continue;
+        assert_int_equal(r.fx[e].rays, 0);
+        assert_int_equal(c.w.rays[e], 0);
+        assert_int_equal(r.fx[e].st.box_tests + r.fx[e].st.qstack_pushes + r.fx[e].st.qstack_pops, 0);
+    }
+    assert_true(r.units.qbvh_stack > 0);
+    assert_int_equal(r.refits + r.units.refit, 0);
+    free(c.rec);
+    cbvh_scene_desc_free(&d);
+}
+
+/* Animated: the QBVH's boxes are refitted every frame (its node count per
+ * refit) and the hits stay the float BVH's on every frame; without the refit
+ * the moved triangles would fall outside the frame-0 boxes. */
+static void qbvh_animated(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA ", \"lights\": [{\"type\": \"point\", \"position\": [8, 16, 10]}],"
+         " \"effects\": [\"primary\", \"hard_shadows\"],"
+         "\"animation\": {\"type\": \"twist\", \"frames\": 3, \"amount\": 0.8}}",
+         &d);
+    static cbvh_fx_result r[2];
+    recorder c[2];
+    run_recorded(&d, CBVH_FORMAT_FLOAT, &c[0], &r[0]);
+    run_recorded(&d, CBVH_FORMAT_QBVH, &c[1], &r[1]);
+    assert_int_equal(r[1].refits, 2);
+    uint64_t nnodes = (r[1].node_bytes - (uint64_t)d.mesh.ntris * 4u) / CBVH_QBVH_NODE_BYTES;
+    assert_int_equal(r[1].units.refit, 2 * nnodes);
+    assert_int_equal(c[1].n, c[0].n);
+    assert_memory_equal(c[1].rec, c[0].rec, c[0].n * sizeof *c[0].rec);
+    assert_int_equal(r[1].hit_digest, r[0].hit_digest);
+    assert_int_equal(r[1].fx[CBVH_FX_PRIMARY].rays, 3 * 24 * 18);
+    free(c[0].rec);
+    free(c[1].rec);
+    cbvh_scene_desc_free(&d);
+}
+
 /* Cameras: fisheye leaves the corners without rays; thin lens shoots spp
  * rays per pixel from different lens points. */
 static void cameras(void **state) {
@@ -388,7 +510,8 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(primary_only), cmocka_unit_test(all_effects), cmocka_unit_test(no_mirror_material),
         cmocka_unit_test(animated_refits), cmocka_unit_test(cameras), cmocka_unit_test(errors),
-        cmocka_unit_test(timing_example),
+        cmocka_unit_test(timing_example), cmocka_unit_test(qbvh_all_effects), cmocka_unit_test(qbvh_effects_obeyed),
+        cmocka_unit_test(qbvh_animated),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -22,6 +22,9 @@ typedef struct {
     uint64_t lines;      /* 64-byte lines fetched: node pairs, ID-array entries, triangles (no cache) */
     uint64_t bytes;      /* lines * 64 */
     uint32_t max_stack;  /* deepest stack occupancy */
+    /* QBVH stack unit (unit 8) operations; 0 for the binary traversals. */
+    uint64_t qstack_pushes; /* sort + push operations: one per inner node visited */
+    uint64_t qstack_pops;   /* pop operations */
 } cbvh_trav_stats;
 
 typedef struct {
