@@ -79,6 +79,7 @@ typedef struct {
  * scale changed; relative: a scale or lower bound changed).
  * With refit_tris != NULL this is the streaming refit: leaf and inner boxes
  * of b are recomputed from refit_tris in the same pass (b is updated). */
+/* st is required (not NULL). */
 int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_compress_opts *o, cbvh_tree *out,
                            cbvh_bu_stats *st, char *err, size_t errlen);
 
