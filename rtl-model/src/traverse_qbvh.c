@@ -1,38 +1,13 @@
 /* QBVH traversal (seed 000) with the compressed stack unit (docs/qbvh.md §4).
  * Boxes: the ray-box unit on float bounds (the prepared entry point that
  * traverse_bvh.c uses, so rays/s compare like for like); triangles: the
- * ray-triangle unit; hit acceptance and box culling as docs/traversal.md §5. */
+ * ray-triangle unit; hit acceptance and box culling shared with the binary
+ * traversals (traverse_common.h, docs/traversal.md §5). */
 #include <stdio.h>
 #include <string.h>
 
 #include "cbvh/qbvh.h"
-#include "ray_prep.h"
-
-typedef struct {
-    const cbvh_ray *ray;
-    cbvh_rb_ray prep;
-    const cbvh_tri *tris;
-    cbvh_trav_mode mode;
-    int M;
-    uint64_t ids_base, tris_base;
-    cbvh_trav_hit best;
-    cbvh_trav_stats s;
-    int done;
-} qstate;
-
-static void fetch(qstate *qs, uint64_t addr, uint64_t size) {
-    uint64_t n = cbvh_lines_touched(addr, size);
-    qs->s.lines += n;
-    qs->s.bytes += n * CBVH_LINE_BYTES;
-}
-
-static uint64_t align_line(uint64_t a) { return (a + CBVH_LINE_BYTES - 1) / CBVH_LINE_BYTES * CBVH_LINE_BYTES; }
-
-static cbvh_f32 box_tmax(const qstate *qs) {
-    cbvh_f32 x = qs->ray->tmax;
-    if (qs->best.hit && cbvh_f32_key(qs->best.t) < cbvh_f32_key(x)) x = qs->best.t;
-    return x == CBVH_F32_POS_INF ? x : cbvh_f32_next_up(x);
-}
+#include "traverse_common.h"
 
 static cbvh_f32 bits(float f) {
     cbvh_f32 b;
@@ -40,35 +15,14 @@ static cbvh_f32 bits(float f) {
     return b;
 }
 
-static int box(qstate *qs, const cbvh_qbvh *q, uint32_t i, cbvh_box_result *r) {
+static int box(trav_state *qs, const cbvh_qbvh *q, uint32_t i, cbvh_box_result *r) {
     cbvh_f32 lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         lo[a] = bits(q->bmin[i][a]);
         hi[a] = bits(q->bmax[i][a]);
     }
     qs->s.box_tests++;
-    return cbvh_ray_box_float_prep(&qs->prep, box_tmax(qs), qs->M, lo, hi, r) == 0 && r->hit;
-}
-
-static void triangle(qstate *qs, uint32_t id) {
-    cbvh_f32 v[3][3];
-    memcpy(v, qs->tris[id].v, sizeof v);
-    fetch(qs, qs->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
-    qs->s.tri_tests++;
-    cbvh_tri_result r;
-    if (cbvh_ray_triangle(qs->ray, v[0], v[1], v[2], &r) || !r.hit) return;
-    int64_t k = cbvh_f32_key(r.t);
-    if (k < cbvh_f32_key(qs->ray->tmin) || k > cbvh_f32_key(qs->ray->tmax)) return;
-    if (qs->best.hit) {
-        int64_t kb = cbvh_f32_key(qs->best.t);
-        if (k > kb || (k == kb && id >= qs->best.prim)) return;
-    }
-    qs->best.hit = 1;
-    qs->best.prim = id;
-    qs->best.t = r.t;
-    qs->best.b1 = r.b1;
-    qs->best.b2 = r.b2;
-    if (qs->mode == CBVH_TRAV_ANY) qs->done = 1;
+    return cbvh_ray_box_float_prep(&qs->prep, trav_box_tmax(qs), qs->M, lo, hi, r) == 0 && r->hit;
 }
 
 int cbvh_qbvh_stack_check(const cbvh_qbvh *q, cbvh_qstack_kind kind, char *err, size_t errlen) {
@@ -91,7 +45,7 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
     char err[160];
     if (cbvh_qbvh_stack_check(q, kind, err, sizeof err)) return -1;
     if (kind == CBVH_QSTACK_AUTO) kind = q->max_first < CBVH_QSTACK_ID_LIMIT ? CBVH_QSTACK_COMPRESSED : CBVH_QSTACK_WIDE;
-    qstate qs;
+    trav_state qs;
     memset(&qs, 0, sizeof qs);
     {
         cbvh_f32 z[3] = {0, 0, 0};
@@ -104,10 +58,10 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
     qs.mode = mode;
     qs.M = mant_bits;
     /* Memory image: bmin (16 B/node), bmax (16 B/node), info (8 B/node), IDs, triangles. */
-    const uint64_t bmin_base = 0, bmax_base = align_line((uint64_t)q->nnodes * 16u),
-                   info_base = bmax_base + align_line((uint64_t)q->nnodes * 16u);
-    qs.ids_base = info_base + align_line((uint64_t)q->nnodes * 8u);
-    qs.tris_base = align_line(qs.ids_base + (uint64_t)q->nprims * 4u);
+    const uint64_t bmin_base = 0, bmax_base = trav_align((uint64_t)q->nnodes * 16u),
+                   info_base = bmax_base + trav_align((uint64_t)q->nnodes * 16u);
+    qs.ids_base = info_base + trav_align((uint64_t)q->nnodes * 8u);
+    qs.tris_base = trav_align(qs.ids_base + (uint64_t)q->nprims * 4u);
 
     uint32_t s32[CBVH_TRAV_STACK];
     uint64_t s64[CBVH_TRAV_STACK];
@@ -122,9 +76,9 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
         if (!(cnt & CBVH_QBVH_LEAF)) {
             uint32_t f = q->first[node];
             qs.s.nodes++;
-            fetch(&qs, bmin_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
-            fetch(&qs, bmax_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
-            fetch(&qs, info_base + (uint64_t)f * 8u, (uint64_t)cnt * 8u);
+            trav_fetch(&qs, bmin_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
+            trav_fetch(&qs, bmax_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
+            trav_fetch(&qs, info_base + (uint64_t)f * 8u, (uint64_t)cnt * 8u);
             uint32_t t[4] = {0, 0, 0, 0}, mask = 0;
             for (uint32_t c = 0; c < cnt; c++) {
                 cbvh_box_result cr;
@@ -165,8 +119,8 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
             }
         } else {
             uint32_t c = cnt & ~CBVH_QBVH_LEAF, p = q->first[node];
-            fetch(&qs, qs.ids_base + (uint64_t)p * 4u, (uint64_t)c * 4u);
-            for (uint32_t i = 0; i < c && !qs.done; i++) triangle(&qs, q->prims[p + i]);
+            trav_fetch(&qs, qs.ids_base + (uint64_t)p * 4u, (uint64_t)c * 4u);
+            for (uint32_t i = 0; i < c && !qs.done; i++) trav_triangle(&qs, q->prims[p + i]);
             if (qs.done) break;
         }
         if (go) continue;
