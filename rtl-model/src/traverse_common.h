@@ -48,6 +48,7 @@ static inline void trav_triangle(trav_state *ts, uint32_t id) {
     if (cbvh_ray_triangle(ts->ray, v[0], v[1], v[2], &r) || !r.hit) return;
     int64_t k = cbvh_f32_key(r.t);
     if (k < cbvh_f32_key(ts->ray->tmin) || k > cbvh_f32_key(ts->ray->tmax)) return;
+    if ((ts->mode & CBVH_TRAV_FRONT_ONLY) && cbvh_tri_facing(ts->ray->d, v[0], v[1], v[2]) <= 0) return;
     if (ts->best.hit) {
         int64_t kb = cbvh_f32_key(ts->best.t);
         if (k > kb || (k == kb && id >= ts->best.prim)) return;
@@ -57,7 +58,7 @@ static inline void trav_triangle(trav_state *ts, uint32_t id) {
     ts->best.t = r.t;
     ts->best.b1 = r.b1;
     ts->best.b2 = r.b2;
-    if (ts->mode == CBVH_TRAV_ANY) ts->done = 1;
+    if (ts->mode & CBVH_TRAV_ANY) ts->done = 1;
 }
 
 /* A ray the units reject (NaN/Inf, zero direction) is an error for the traversal. */

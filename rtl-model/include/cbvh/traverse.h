@@ -33,7 +33,15 @@ typedef struct {
     cbvh_f32 t, b1, b2;  /* ray-triangle unit outputs of that triangle */
 } cbvh_trav_hit;
 
-typedef enum { CBVH_TRAV_CLOSEST = 0, CBVH_TRAV_ANY = 1 } cbvh_trav_mode;
+/* Bit 0: any hit; bit 1: one-sided (a triangle counts only where
+ * cbvh_tri_facing is +1: what back-face culling assumes). */
+typedef enum {
+    CBVH_TRAV_CLOSEST = 0,
+    CBVH_TRAV_ANY = 1,
+    CBVH_TRAV_FRONT_ONLY = 2,
+    CBVH_TRAV_CLOSEST_FRONT = 2,
+    CBVH_TRAV_ANY_FRONT = 3,
+} cbvh_trav_mode;
 
 /* Closest hit = the smallest (t bit pattern, triangle index) over all
  * triangles the ray-triangle unit hits with t in [tmin, tmax]; independent of
