@@ -18,6 +18,10 @@
 #include <time.h>
 
 #include "cbvh/datapath.h"
+#include "cbvh/traversal_units.h"
+
+/* The ray-sphere unit's exact path alone (rtl-model/src/ray_sphere_internal.h). */
+uint32_t cbvh_ray_sphere_exact_only(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r, int *hit);
 
 #define NB 4096 /* boxes per input set (power of two) */
 
@@ -88,6 +92,55 @@ static void make_inputs(void) {
         cbvh_child_out out[2];
         if (cbvh_nodepair_encode(&P, CBVH_ENC_MODULO, &nctx[i], nchild[i], nbytes[i], out)) abort();
     }
+}
+
+/* Ray-sphere inputs (unit 9), like a traversal list's sphere elements: spheres
+ * of radius 2^-8..2^2 in +-64, rays from the scene box; set 0: random
+ * directions (nearly all misses), set 1: aimed inside the sphere (hits), set 2:
+ * half and half.  tmax = +Inf or a finite culling bound. */
+typedef struct {
+    cbvh_ray ray;
+    cbvh_f32 c[3], r;
+} sphere_input;
+static sphere_input sph[3][NB];
+
+static void make_sphere_inputs(void) {
+    for (int set = 0; set < 3; set++)
+        for (int i = 0; i < NB; i++) {
+            sphere_input *x = &sph[set][i];
+            float c[3], o[3], r = (float)ldexp(1.0, -8 + (int)(rng() % 10)) * (float)(0.5 + unit());
+            int aim = set == 1 || (set == 2 && (i & 1));
+            for (int a = 0; a < 3; a++) {
+                c[a] = (float)(unit() * 128.0 - 64.0);
+                o[a] = (float)(unit() * 128.0 - 64.0);
+                x->c[a] = f2b(c[a]);
+                x->ray.o[a] = f2b(o[a]);
+            }
+            for (int a = 0; a < 3; a++) {
+                float d = aim ? c[a] - o[a] + (float)((unit() - 0.5) * r) : (float)(unit() * 2.0 - 1.0);
+                x->ray.d[a] = f2b(d);
+            }
+            x->r = f2b(r);
+            x->ray.tmin = 0;
+            x->ray.tmax = rng() % 2 ? CBVH_F32_POS_INF : f2b((float)(unit() * 4.0));
+        }
+}
+
+/* Float baseline: the textbook discriminant test in binary32 (not exact). */
+static int naive_sphere(const sphere_input *x) {
+    float o[3], d[3], w[3], A = 0, B = 0, C = 0;
+    for (int a = 0; a < 3; a++) {
+        o[a] = b2f(x->ray.o[a]);
+        d[a] = b2f(x->ray.d[a]);
+        w[a] = b2f(x->c[a]) - o[a];
+        A += d[a] * d[a];
+        B += w[a] * d[a];
+        C += w[a] * w[a];
+    }
+    float r = b2f(x->r), tmax = b2f(x->ray.tmax);
+    float t = B / A;
+    t = t < 0 ? 0 : t > tmax ? tmax : t;
+    return A * t * t - 2 * B * t + C <= r * r;
 }
 
 /* ---- naive float baselines (not bit-exact: float ops, round to nearest) ---- */
@@ -201,6 +254,7 @@ int main(int argc, char **argv) {
     }
     rng_state = seed;
     make_inputs();
+    make_sphere_inputs();
 
     double t_comp, t_dmod, t_drel, t_est, t_enc, t_dec, t_nl, t_nm, t_nd;
     TIME_LOOP(t_comp, 1, NB, {
@@ -250,6 +304,30 @@ int main(int argc, char **argv) {
         acc += out[1].axis[2].cub;
     });
 
+    double t_sph[3], t_sph_exact[3], t_sph_naive[3];
+    int sph_hits[3] = {0, 0, 0};
+    for (int set = 0; set < 3; set++) {
+        const sphere_input *sx = sph[set];
+        for (int i = 0; i < NB; i++) {
+            int h, he;
+            cbvh_ray_sphere(&sx[i].ray, sx[i].c, sx[i].r, &h);
+            cbvh_ray_sphere_exact_only(&sx[i].ray, sx[i].c, sx[i].r, &he);
+            if (h != he) abort(); /* the fast path never changes a result */
+            sph_hits[set] += h;
+        }
+        TIME_LOOP(t_sph[set], 1, NB, {
+            int h;
+            acc += cbvh_ray_sphere(&sx[i].ray, sx[i].c, sx[i].r, &h);
+            acc += (uint32_t)h;
+        });
+        TIME_LOOP(t_sph_exact[set], 1, NB, {
+            int h;
+            acc += cbvh_ray_sphere_exact_only(&sx[i].ray, sx[i].c, sx[i].r, &h);
+            acc += (uint32_t)h;
+        });
+        TIME_LOOP(t_sph_naive[set], 1, NB, { acc += (uint32_t)naive_sphere(&sx[i]); });
+    }
+
     printf("cbvh datapath benchmark: N=%d, min_scale=%d, %d scene-like boxes, best of 5 x >= %.2f s\n", P.quant_bits,
            P.min_scale, NB, min_seconds);
     printf("ratio = model ns/op / baseline ns/op (below 1: the bit-exact model is faster)\n");
@@ -262,6 +340,13 @@ int main(int argc, char **argv) {
     row("scale_estimate", t_est, 0, "");
     row("nodepair_encode (pair)", t_enc, 0, "");
     row("nodepair_decode (pair)", t_dec, 0, "");
+    static const char *const sph_names[3] = {"ray_sphere (misses)", "ray_sphere (hits)", "ray_sphere (50/50)"};
+    for (int set = 0; set < 3; set++) {
+        char name[64];
+        snprintf(name, sizeof name, "%s %d%%", sph_names[set], (int)(100.0 * sph_hits[set] / NB + 0.5));
+        row(name, t_sph[set], t_sph_exact[set], "exact path only");
+        row("", t_sph[set], t_sph_naive[set], "float discriminant");
+    }
     printf("target: >= 100 Mops/s single-axis compressions on one core: %s (%.1f Mops/s)\n",
            1e3 / t_comp >= 100.0 ? "MET" : "NOT MET", 1e3 / t_comp);
     return 0;

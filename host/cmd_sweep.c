@@ -2,8 +2,8 @@
  * float BVH and every CBVH setting trace the same rays in one run; costs are
  * printed relative to the float BVH, a chart and heat maps go to --out, and
  * every setting must return the float BVH's hits (exit 1 naming the first
- * differing ray otherwise).  --formats cbvh,qbvh adds the QBVH as one more
- * row, checked the same way. */
+ * differing ray otherwise).  --formats cbvh,qbvh,tlist... adds the QBVH and
+ * traversal lists as more rows, checked the same way. */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,7 +23,8 @@
 static void usage(FILE *f) {
     fprintf(f,
             "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
-            "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,qbvh]]\n"
+            "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,F...]]\n"
+            "                        [--one-sided]\n"
             "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
             "  setting N x M x E, on the same rays, and prints per setting and effect: box and triangle\n"
             "  tests, bytes per ray, node memory, modelled time and CPU time, each relative to the float\n"
@@ -34,11 +35,16 @@ static void usage(FILE *f) {
             "  --min-scale E...  minimum grid scale, -126..126 (default %d)\n"
             "  --spp K           camera samples per pixel, 1..1024 (default: the scene's)\n"
             "  --out DIR         where the chart and heat maps go (default sweep-<scene name>)\n"
-            "  --heatmap S...    settings to draw box tests per pixel for: float, qbvh, N, or N:M:E\n"
-            "                    (default float 3 6 10, those in range, and qbvh if traced; N uses the first M, E)\n"
+            "  --heatmap S...    settings to draw box tests per pixel for: float, N, N:M:E, or a traced format\n"
+            "                    (qbvh, tlist...; default float 3 6 10, those in range, and every other format\n"
+            "                    traced; N uses the first M, E)\n"
             "  --knee PCT        knee tolerance in percent, 0..1000 (default 10)\n"
-            "  --formats F,...   formats compared with the float BVH: cbvh (default; always), qbvh (one more\n"
-            "                    row: the 4-ary QBVH with the compressed stack, docs/qbvh.md, at the first M)\n"
+            "  --formats F,...   formats compared with the float BVH: cbvh (default; always), and more rows:\n"
+            "                    qbvh (4-ary QBVH with the compressed stack, docs/qbvh.md, at the first M),\n"
+            "                    tlist[:1|2|6|8][:earliest|:latest][:cull][:heads] (traversal lists over a\n"
+            "                    bounding-sphere hierarchy, docs/tlist.md; default 6 lists, earliest first)\n"
+            "  --one-sided       triangles count only from their front side (counter-clockwise), on every\n"
+            "                    format; needed by tlist:...:cull (back-face culling)\n"
             "  --json            machine-readable output on stdout\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
 }
@@ -96,10 +102,27 @@ static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, l
 }
 
 typedef struct {
-    int is_float, is_qbvh;
+    int is_float;
+    int xf;               /* 1 + index into the other formats, 0 = none */
+    char fmt[48];         /* a format name given on the command line, resolved after parsing */
     int bits, mant, min_scale; /* mant/min_scale < -1000: the first of the lists */
     int explicit_all;
 } heat_spec;
+
+/* A format name of --formats / --heatmap: "qbvh" or a tlist spec; the
+ * canonical name goes to f.  0 or -1. */
+static int parse_format(const char *t, cbvh_sweep_format *f, char *err, size_t errlen) {
+    memset(f, 0, sizeof *f);
+    if (strcmp(t, "qbvh") == 0) {
+        f->format = CBVH_FORMAT_QBVH;
+        snprintf(f->name, sizeof f->name, "qbvh");
+        return 0;
+    }
+    if (cbvh_tlist_opts_parse(t, &f->tlist, err, errlen)) return -1;
+    f->format = CBVH_FORMAT_TLIST;
+    cbvh_tlist_opts_name(&f->tlist, f->name, sizeof f->name);
+    return 0;
+}
 
 static int parse_heat(const char *s, heat_spec *h) {
     memset(h, 0, sizeof *h);
@@ -107,8 +130,11 @@ static int parse_heat(const char *s, heat_spec *h) {
         h->is_float = 1;
         return 0;
     }
-    if (strcmp(s, "qbvh") == 0) {
-        h->is_qbvh = 1;
+    if (strcmp(s, "qbvh") == 0 || strncmp(s, "tlist", 5) == 0) {
+        cbvh_sweep_format f;
+        char e[160];
+        if (parse_format(s, &f, e, sizeof e)) return -1;
+        snprintf(h->fmt, sizeof h->fmt, "%s", f.name);
         return 0;
     }
     char buf[64], *p[3];
@@ -168,7 +194,7 @@ static void text_row(const char *setting, const char *effect, const cbvh_fx_stat
     double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
     cbvh_sweep_per_ray(s, tp, p);
     cbvh_sweep_per_ray(f, tp, q);
-    printf("%-16s %-17s %8llu %8.2f %7.2f %8.1f %9.1f %7.2f |", setting, effect, (unsigned long long)s->rays,
+    printf("%-28s %-17s %8llu %8.2f %7.2f %8.1f %9.1f %7.2f |", setting, effect, (unsigned long long)s->rays,
            p[SWEEP_BOX], p[SWEEP_TRI], p[SWEEP_BYTES], p[SWEEP_MODEL_NS], p[SWEEP_CPU_US]);
     print_rel(rel(p[SWEEP_BOX], q[SWEEP_BOX]));
     print_rel(rel(p[SWEEP_TRI], q[SWEEP_TRI]));
@@ -298,13 +324,14 @@ int cmd_sweep(int argc, char **argv) {
             int n0 = nheat;
             while (i + 1 < argc && argv[i + 1][0] != '-' && (strcmp(argv[i + 1], "float") == 0 ||
                                                               strcmp(argv[i + 1], "qbvh") == 0 ||
+                                                              strncmp(argv[i + 1], "tlist", 5) == 0 ||
                                                               (argv[i + 1][0] >= '0' && argv[i + 1][0] <= '9'))) {
                 if (nheat == MAX_HEAT) {
                     fprintf(stderr, "cbvh sweep: --heatmap takes at most %d settings\n", MAX_HEAT);
                     return 2;
                 }
                 if (parse_heat(argv[i + 1], &heat[nheat])) {
-                    fprintf(stderr, "cbvh sweep: --heatmap expects float, qbvh, N or N:M:E (N in %d..%d), got '%s'\n",
+                    fprintf(stderr, "cbvh sweep: --heatmap expects float, N, N:M:E (N in %d..%d) or a format, got '%s'\n",
                             CBVH_N_MIN, CBVH_N_MAX, argv[i + 1]);
                     return 2;
                 }
@@ -312,28 +339,49 @@ int cmd_sweep(int argc, char **argv) {
                 i++;
             }
             if (nheat == n0) {
-                fprintf(stderr, "cbvh sweep: --heatmap expects float, qbvh, N or N:M:E (N in %d..%d), got '%s'\n",
+                fprintf(stderr, "cbvh sweep: --heatmap expects float, N, N:M:E (N in %d..%d) or a format, got '%s'\n",
                         CBVH_N_MIN, CBVH_N_MAX, i + 1 < argc ? argv[i + 1] : "");
                 return 2;
             }
-        } else if (strcmp(a, "--formats") == 0) {
+        } else if (strcmp(a, "--one-sided") == 0)
+            o.one_sided = 1;
+        else if (strcmp(a, "--formats") == 0) {
             const char *v = i + 1 < argc ? argv[++i] : "";
-            char buf[64];
+            char buf[512], ferr[200] = "";
             size_t len = strlen(v);
-            int cb = 0, qb = 0, bad = len >= sizeof buf || !*v;
+            int cb = 0, bad = len >= sizeof buf || !*v;
             if (!bad) memcpy(buf, v, len + 1);
-            for (char *t = strtok(buf, ","); t && !bad; t = strtok(NULL, ","))
-                if (strcmp(t, "cbvh") == 0)
+            o.nextra = 0;
+            for (char *t = strtok(buf, ","); t && !bad; t = strtok(NULL, ",")) {
+                if (strcmp(t, "cbvh") == 0) {
                     cb = 1;
-                else if (strcmp(t, "qbvh") == 0)
-                    qb = 1;
-                else
+                    continue;
+                }
+                cbvh_sweep_format f;
+                if (strcmp(t, "qbvh") != 0 && strncmp(t, "tlist", 5) != 0)
                     bad = 1;
-            if (bad || !cb) {
-                fprintf(stderr, "cbvh sweep: --formats expects cbvh or cbvh,qbvh, got '%s'\n", v);
+                else if (parse_format(t, &f, ferr, sizeof ferr))
+                    bad = 2;
+                else if (o.nextra == CBVH_SWEEP_MAX_EXTRA) {
+                    snprintf(ferr, sizeof ferr, "at most %d formats besides cbvh", CBVH_SWEEP_MAX_EXTRA);
+                    bad = 2;
+                } else {
+                    for (int k = 0; k < o.nextra; k++)
+                        if (strcmp(o.extra[k].name, f.name) == 0) {
+                            snprintf(ferr, sizeof ferr, "format %s given twice", f.name);
+                            bad = 2;
+                        }
+                    if (!bad) o.extra[o.nextra++] = f;
+                }
+            }
+            if (bad == 2) {
+                fprintf(stderr, "cbvh sweep: --formats: %s\n", ferr);
                 return 2;
             }
-            o.qbvh = qb;
+            if (bad || !cb) {
+                fprintf(stderr, "cbvh sweep: --formats expects cbvh[,qbvh][,tlist[:options]...], got '%s'\n", v);
+                return 2;
+            }
         } else if (strcmp(a, "--test-corrupt") == 0) {
             /* Test hook (docs/sweep.md): SETTING_INDEX:RAY_INDEX. */
             corrupt = i + 1 < argc ? argv[++i] : "";
@@ -367,15 +415,17 @@ int cmd_sweep(int argc, char **argv) {
         static const int def[] = {3, 6, 10};
         for (int k = 0; k < 3; k++)
             if (def[k] >= o.bits_lo && def[k] <= o.bits_hi) heat[nheat++] = (heat_spec){.bits = def[k]};
-        if (o.qbvh) heat[nheat++] = (heat_spec){.is_qbvh = 1};
+        for (int k = 0; k < o.nextra && nheat < MAX_HEAT; k++) heat[nheat++] = (heat_spec){.xf = k + 1};
     }
     /* Every heat-map setting must be one the sweep traces. */
     for (int h = 0; h < nheat; h++) {
         heat_spec *s = &heat[h];
-        if (s->is_float) continue;
-        if (s->is_qbvh) {
-            if (!o.qbvh) {
-                fprintf(stderr, "cbvh sweep: --heatmap qbvh needs --formats cbvh,qbvh\n");
+        if (s->is_float || s->xf) continue;
+        if (s->fmt[0]) {
+            for (int k = 0; k < o.nextra; k++)
+                if (strcmp(o.extra[k].name, s->fmt) == 0) s->xf = k + 1;
+            if (!s->xf) {
+                fprintf(stderr, "cbvh sweep: --heatmap %s needs --formats cbvh,%s\n", s->fmt, s->fmt);
                 return 2;
             }
             continue;
@@ -405,9 +455,9 @@ int cmd_sweep(int argc, char **argv) {
         return 2;
     }
     int nb = o.bits_hi - o.bits_lo + 1;
-    if (o.corrupt_setting >= nb * o.nmant * o.nmin_scale + o.qbvh) {
+    if (o.corrupt_setting >= nb * o.nmant * o.nmin_scale + o.nextra) {
         fprintf(stderr, "cbvh sweep: --test-corrupt setting %d: the sweep has %d settings\n", o.corrupt_setting,
-                nb * o.nmant * o.nmin_scale + o.qbvh);
+                nb * o.nmant * o.nmin_scale + o.nextra);
         cbvh_scene_desc_free(&d);
         return 2;
     }
@@ -484,8 +534,8 @@ int cmd_sweep(int argc, char **argv) {
     double vmax = 0;
     size_t npx = (size_t)res.width * (size_t)res.height;
     for (int h = 0; h < nheat; h++) {
-        hr[h] = heat[h].is_qbvh ? &res.qbvh : &res.ref;
-        if (!heat[h].is_float && !heat[h].is_qbvh)
+        hr[h] = heat[h].xf ? &res.extra[heat[h].xf - 1] : &res.ref;
+        if (!heat[h].is_float && !heat[h].xf)
             for (int i = 0; i < res.nrows; i++)
                 if (res.rows[i].s.bits == heat[h].bits && res.rows[i].s.mant == heat[h].mant &&
                     res.rows[i].s.min_scale == heat[h].min_scale)
@@ -498,8 +548,13 @@ int cmd_sweep(int argc, char **argv) {
     for (int h = 0; h < nheat; h++) {
         if (heat[h].is_float)
             snprintf(path, sizeof path, "%s/heat-float.png", outdir);
-        else if (heat[h].is_qbvh)
-            snprintf(path, sizeof path, "%s/heat-qbvh.png", outdir);
+        else if (heat[h].xf) {
+            char fn[48];
+            snprintf(fn, sizeof fn, "%s", o.extra[heat[h].xf - 1].name);
+            for (char *p = fn; *p; p++)
+                if (*p == ':') *p = '-';
+            snprintf(path, sizeof path, "%s/heat-%s.png", outdir, fn);
+        }
         else if (heat[h].explicit_all)
             snprintf(path, sizeof path, "%s/heat-N%d-M%d-E%d.png", outdir, heat[h].bits, heat[h].mant,
                      heat[h].min_scale);
@@ -525,7 +580,8 @@ int cmd_sweep(int argc, char **argv) {
             first_bad = i;
             break;
         }
-    if (first_bad < 0 && res.have_qbvh && !res.qbvh.same) first_bad = res.nrows;
+    for (int k = 0; first_bad < 0 && k < res.nextra; k++)
+        if (!res.extra[k].same) first_bad = res.nrows + k;
     static const char *knee_keys[4] = {"box_tests", "tri_tests", "bytes", "model_time"};
     if (json) {
         cJSON *root = cJSON_CreateObject();
@@ -571,12 +627,16 @@ int cmd_sweep(int argc, char **argv) {
             cJSON_AddItemToObject(row, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
             cJSON_AddItemToArray(rows, row);
         }
-        if (res.have_qbvh) {
-            const cbvh_sweep_run_t *r = &res.qbvh;
-            cJSON *qj = cJSON_AddObjectToObject(root, "qbvh");
+        cJSON *fj = res.nextra ? cJSON_AddArrayToObject(root, "formats") : NULL;
+        for (int k = 0; k < res.nextra; k++) {
+            const cbvh_sweep_run_t *r = &res.extra[k];
+            cJSON *qj = cJSON_CreateObject();
+            cJSON_AddItemToArray(fj, qj);
+            cJSON_AddStringToObject(qj, "format", o.extra[k].name);
             cJSON_AddNumberToObject(qj, "mant", r->s.mant);
             cJSON_AddNumberToObject(qj, "node_bytes", (double)r->r.node_bytes);
             cJSON_AddNumberToObject(qj, "qbvh_stack", (double)r->r.units.qbvh_stack);
+            cJSON_AddNumberToObject(qj, "ray_sphere", (double)r->r.units.ray_sphere);
             cJSON_AddBoolToObject(qj, "same_hits", r->same);
             if (!r->same) cJSON_AddStringToObject(qj, "first_difference", r->why);
             cJSON *ef = cJSON_AddObjectToObject(qj, "effects");
@@ -613,18 +673,20 @@ int cmd_sweep(int argc, char **argv) {
         printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
                "(docs/timing_model.md)\n\n",
                tp.box_cycles, tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
-        printf("%-16s %-17s %8s %8s %7s %8s %9s %7s | %7s %7s %7s %7s %7s %7s  %s\n", "setting", "effect", "rays",
+        printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %7s %7s %7s %7s %7s %7s  %s\n", "setting", "effect", "rays",
                "box/ray", "tri/ray", "B/ray", "model ns", "CPU us", "box", "tri", "bytes", "memory", "model", "CPU",
                "hits");
-        printf("%-16s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
+        printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
                "relative to the float BVH ----------------------------");
         char name[48];
-        for (int i = -1; i < res.nrows + res.have_qbvh; i++) {
-            const cbvh_sweep_run_t *r = i < 0 ? &res.ref : i == res.nrows ? &res.qbvh : &res.rows[i];
+        for (int i = -1; i < res.nrows + res.nextra; i++) {
+            const cbvh_sweep_run_t *r = i < 0 ? &res.ref : i >= res.nrows ? &res.extra[i - res.nrows] : &res.rows[i];
             if (i < 0)
                 snprintf(name, sizeof name, "float");
-            else if (i == res.nrows)
+            else if (i >= res.nrows && o.extra[i - res.nrows].format == CBVH_FORMAT_QBVH)
                 snprintf(name, sizeof name, "qbvh M=%d", r->s.mant);
+            else if (i >= res.nrows)
+                snprintf(name, sizeof name, "%s", o.extra[i - res.nrows].name);
             else
                 snprintf(name, sizeof name, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
             const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
@@ -637,7 +699,8 @@ int cmd_sweep(int argc, char **argv) {
         }
         printf("\nnode memory: float BVH %llu B", (unsigned long long)res.ref.r.node_bytes);
         for (int b = 0; b < nb; b++) printf(", N=%d %llu B", res.rows[b].s.bits, (unsigned long long)res.rows[b].r.node_bytes);
-        if (res.have_qbvh) printf(", qbvh %llu B", (unsigned long long)res.qbvh.r.node_bytes);
+        for (int k = 0; k < res.nextra; k++)
+            printf(", %s %llu B", o.extra[k].name, (unsigned long long)res.extra[k].r.node_bytes);
         printf("\n");
         printf("knee = smallest N from which every finer N costs at most %ld%% more than N=%d (totals over effects):\n",
                knee_pct, o.bits_hi);
@@ -656,24 +719,32 @@ int cmd_sweep(int argc, char **argv) {
                            relv[(size_t)SWEEP_BOX * res.nrows + c * nb + b],
                            relv[(size_t)SWEEP_TRI * res.nrows + c * nb + b]);
         if (res.all_same)
-            printf("hits: all %d settings%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
+            printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
                    "false misses) and render the same %dx%d image\n",
-                   res.nrows, res.have_qbvh ? " and the QBVH" : "", (unsigned long long)res.ref_rays, res.width,
-                   res.height);
+                   res.nrows, res.nextra == 1 && o.extra[0].format == CBVH_FORMAT_QBVH ? " and the QBVH"
+                              : res.nextra                                            ? " and the other formats"
+                                                                                      : "",
+                   o.one_sided ? " (one-sided)" : "", (unsigned long long)res.ref_rays, res.width, res.height);
         else {
             for (int i = 0; i < res.nrows; i++)
                 if (!res.rows[i].same)
                     printf("hits: N=%d M=%d E=%d DIFFERENT from the float BVH: %s\n", res.rows[i].s.bits,
                            res.rows[i].s.mant, res.rows[i].s.min_scale, res.rows[i].why);
-            if (res.have_qbvh && !res.qbvh.same)
-                printf("hits: qbvh M=%d DIFFERENT from the float BVH: %s\n", res.qbvh.s.mant, res.qbvh.why);
+            for (int k = 0; k < res.nextra; k++)
+                if (!res.extra[k].same)
+                    printf("hits: %s DIFFERENT from the float BVH: %s\n", o.extra[k].name, res.extra[k].why);
         }
         printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all\n", used_max);
         for (int k = 0; k < nwritten; k++) printf("wrote %s\n", written[k]);
     }
-    if (first_bad == res.nrows)
-        fprintf(stderr, "cbvh sweep: qbvh M=%d differs from the float BVH: %s\n", res.qbvh.s.mant, res.qbvh.why);
-    else if (first_bad >= 0) {
+    if (first_bad >= res.nrows) {
+        const cbvh_sweep_run_t *r = &res.extra[first_bad - res.nrows];
+        if (o.extra[first_bad - res.nrows].format == CBVH_FORMAT_QBVH)
+            fprintf(stderr, "cbvh sweep: qbvh M=%d differs from the float BVH: %s\n", r->s.mant, r->why);
+        else
+            fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", o.extra[first_bad - res.nrows].name,
+                    r->why);
+    } else if (first_bad >= 0) {
         const cbvh_sweep_run_t *r = &res.rows[first_bad];
         fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits, r->s.mant,
                 r->s.min_scale, r->why);

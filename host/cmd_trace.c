@@ -13,17 +13,21 @@
 
 static void usage(FILE *f) {
     fprintf(f,
-            "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format float|cbvh|qbvh] [--json]\n"
-            "                        [--spp K]\n"
+            "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format float|cbvh|qbvh|tlist...]\n"
+            "                        [--spp K] [--one-sided] [--json]\n"
             "  Traces the rays the scene file's effects call for (docs/scenes.md) and prints, per effect:\n"
             "  rays, box/triangle tests, nodes and bytes per ray, deepest stack, modelled time per ray\n"
-            "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default) or qbvh\n"
-            "  also each relative to the float BVH on the same rays, and a units-active line.\n"
+            "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default), qbvh\n"
+            "  or tlist also each relative to the float BVH on the same rays, and a units-active line.\n"
             "  --bits N       CBVH coordinate bits, %d..%d (default 6)\n"
             "  --mant M       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
             "  --min-scale E  minimum grid scale, -126..126 (default %d)\n"
             "  --format F     float: the float BVH only; cbvh: the CBVH against the float BVH (default);\n"
-            "                 qbvh: the QBVH (4-ary, compressed 32-bit stack, docs/qbvh.md) against it\n"
+            "                 qbvh: the QBVH (4-ary, compressed 32-bit stack, docs/qbvh.md) against it;\n"
+            "                 tlist[:1|2|6|8][:earliest|:latest][:cull][:heads]: traversal lists over a\n"
+            "                 bounding-sphere hierarchy (docs/tlist.md; default 6 lists, earliest first)\n"
+            "  --one-sided    triangles count only from their front side (counter-clockwise), on every\n"
+            "                 format; needed by tlist:...:cull\n"
             "  --spp K        camera samples per pixel, 1..1024 (default: the scene's camera.spp)\n"
             "  --json         machine-readable output\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
@@ -135,24 +139,24 @@ static void json_result(const char *key, const cbvh_scene_desc *d, const cbvh_fx
     printf("},");
     json_stats("total", &t, tp, 0);
     printf(",\"units\":{\"compressor\":%llu,\"decoder\":%llu,\"ray_box\":%llu,\"ray_triangle\":%llu,\"refit\":%llu,"
-           "\"qbvh_stack\":%llu},\"qbvh_stack_pushes\":%llu,\"qbvh_stack_pops\":%llu,\"hit_digest\":\"%016llx\"}",
+           "\"qbvh_stack\":%llu,\"ray_sphere\":%llu},\"qbvh_stack_pushes\":%llu,\"qbvh_stack_pops\":%llu,\"hit_digest\":\"%016llx\"}",
            (unsigned long long)r->units.compressor, (unsigned long long)r->units.decoder,
            (unsigned long long)r->units.ray_box, (unsigned long long)r->units.ray_triangle,
            (unsigned long long)r->units.refit, (unsigned long long)r->units.qbvh_stack,
-           (unsigned long long)t.st.qstack_pushes, (unsigned long long)t.st.qstack_pops,
+           (unsigned long long)r->units.ray_sphere, (unsigned long long)t.st.qstack_pushes, (unsigned long long)t.st.qstack_pops,
            (unsigned long long)r->hit_digest);
 }
 
 static void print_units(const cbvh_unit_activity *u, int animated) {
-    const char *names[] = {"compressor", "decoder", "ray_box", "ray_triangle", "refit", "qbvh_stack"};
-    uint64_t v[] = {u->compressor, u->decoder, u->ray_box, u->ray_triangle, u->refit, u->qbvh_stack};
+    const char *names[] = {"compressor", "decoder", "ray_box", "ray_triangle", "refit", "qbvh_stack", "ray_sphere"};
+    uint64_t v[] = {u->compressor, u->decoder, u->ray_box, u->ray_triangle, u->refit, u->qbvh_stack, u->ray_sphere};
     printf("units active:");
     int any = 0;
-    for (int i = 0; i < 6; i++)
+    for (int i = 0; i < 7; i++)
         if (v[i]) printf("%s %s %llu", any++ ? "," : "", names[i], (unsigned long long)v[i]);
     printf("  | idle:");
     any = 0;
-    for (int i = 0; i < 6; i++)
+    for (int i = 0; i < 7; i++)
         if (!v[i]) printf("%s %s", any++ ? "," : "", names[i]);
     if (!any) printf(" none");
     printf("%s\n", animated ? "" : "  (static scene: no refit)");
@@ -162,6 +166,10 @@ int cmd_trace(int argc, char **argv) {
     const char *scene = NULL;
     int bits = 6, mant = 24, min_scale = CBVH_MIN_SCALE_DEFAULT, spp = 0, json = 0;
     cbvh_accel_format fmt = CBVH_FORMAT_CBVH;
+    cbvh_tlist_opts tlo;
+    char tlname[48] = "tlist", terr[200];
+    int one_sided = 0;
+    cbvh_tlist_opts_parse("tlist", &tlo, terr, sizeof terr);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -185,10 +193,19 @@ int cmd_trace(int argc, char **argv) {
                 fmt = CBVH_FORMAT_CBVH;
             else if (strcmp(f, "qbvh") == 0)
                 fmt = CBVH_FORMAT_QBVH;
-            else {
-                fprintf(stderr, "cbvh trace: --format expects float, cbvh or qbvh, got '%s'\n", f);
+            else if (strncmp(f, "tlist", 5) == 0) {
+                if (cbvh_tlist_opts_parse(f, &tlo, terr, sizeof terr)) {
+                    fprintf(stderr, "cbvh trace: --format: %s\n", terr);
+                    return 2;
+                }
+                fmt = CBVH_FORMAT_TLIST;
+                cbvh_tlist_opts_name(&tlo, tlname, sizeof tlname);
+            } else {
+                fprintf(stderr, "cbvh trace: --format expects float, cbvh, qbvh or tlist[:options], got '%s'\n", f);
                 return 2;
             }
+        } else if (strcmp(a, "--one-sided") == 0) {
+            one_sided = 1;
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "cbvh trace: unknown option '%s' (see cbvh trace --help)\n", a);
             return 2;
@@ -212,8 +229,14 @@ int cmd_trace(int argc, char **argv) {
     cbvh_fx_timing(&d, &tp);
     progress_ctx pc = {"float", 0};
     int tty = isatty(2) && !json;
-    cbvh_fx_opts fo = {CBVH_FORMAT_FLOAT, {bits, min_scale}, fmt == CBVH_FORMAT_FLOAT ? mant : 24, spp, NULL,
-                       tty ? progress : NULL, &pc};
+    cbvh_fx_opts fo = {.format = CBVH_FORMAT_FLOAT,
+                       .params = {bits, min_scale},
+                       .mant = fmt == CBVH_FORMAT_FLOAT ? mant : 24,
+                       .spp = spp,
+                       .progress = tty ? progress : NULL,
+                       .ctx = &pc};
+    fo.tlist = tlo;
+    fo.one_sided = one_sided;
     static cbvh_fx_result rf, rc;
     int status = 0;
     if (cbvh_fx_run(&d, &fo, &rf, err, sizeof err)) {
@@ -225,7 +248,7 @@ int cmd_trace(int argc, char **argv) {
     const cbvh_fx_result *main_r = &rf;
     int cmp = fmt != CBVH_FORMAT_FLOAT; /* a format compared against the float BVH */
     if (cmp) {
-        pc.label = cbvh_format_name(fmt);
+        pc.label = fmt == CBVH_FORMAT_TLIST ? tlname : cbvh_format_name(fmt);
         fo.format = fmt;
         fo.mant = mant;
         if (cbvh_fx_run(&d, &fo, &rc, err, sizeof err)) {
@@ -235,7 +258,7 @@ int cmd_trace(int argc, char **argv) {
             return 1;
         }
         main_r = &rc;
-        if (rc.hit_digest != rf.hit_digest) status = 1; /* CBVH / QBVH must return the float BVH's hits */
+        if (rc.hit_digest != rf.hit_digest) status = 1; /* every format must return the float BVH's hits */
     }
     if (pc.last_row) fprintf(stderr, "\r%60s\r", "");
     int spp_used = spp ? spp : d.camera.spp;
@@ -246,15 +269,15 @@ int cmd_trace(int argc, char **argv) {
         printf(",\"mesh\":");
         json_str(d.mesh_spec);
         printf(",\"triangles\":%u,\"frames\":%d,\"camera\":\"%s\",\"width\":%d,"
-               "\"height\":%d,\"spp\":%d,\"format\":\"%s\",\"bits\":%d,\"mant\":%d,\"min_scale\":%d,"
+               "\"height\":%d,\"spp\":%d,\"one_sided\":%s,\"format\":\"%s\",\"bits\":%d,\"mant\":%d,\"min_scale\":%d,"
                "\"timing\":{\"box_cycles\":%g,\"tri_cycles\":%g,\"fetch_latency\":%g,\"dram_bytes_per_cycle\":%g,"
                "\"clock_mhz\":%g}",
                d.mesh.ntris, rf.frames, cams[d.camera.type], d.camera.width, d.camera.height,
-               spp_used, cbvh_format_name(fmt), bits, mant, min_scale, tp.box_cycles,
+               spp_used, one_sided ? "true" : "false", fmt == CBVH_FORMAT_TLIST ? tlname : cbvh_format_name(fmt), bits, mant, min_scale, tp.box_cycles,
                tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
         json_result("float", &d, &rf, &tp);
         if (cmp) {
-            json_result(cbvh_format_name(fmt), &d, &rc, &tp);
+            json_result(fmt == CBVH_FORMAT_TLIST ? "tlist" : cbvh_format_name(fmt), &d, &rc, &tp);
             printf(",\"same_hits\":%s", status ? "false" : "true");
         }
         printf("}\n");
@@ -270,8 +293,13 @@ int cmd_trace(int argc, char **argv) {
             printf("format qbvh: 4-ary, compressed 32-bit stack, M=%d; node memory %llu B (float BVH %llu B, x%.3f)\n",
                    mant, (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
                    ratio((double)rc.node_bytes, (double)rf.node_bytes));
+        else if (fmt == CBVH_FORMAT_TLIST)
+            printf("format %s: sphere hierarchy + lists; list memory %llu B (float BVH %llu B, x%.3f)\n", tlname,
+                   (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
+                   ratio((double)rc.node_bytes, (double)rf.node_bytes));
         else
             printf("format float: M=%d; node memory %llu B\n", mant, (unsigned long long)rf.node_bytes);
+        if (one_sided) printf("one-sided: triangles count only from their counter-clockwise front side\n");
         printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
                "(docs/timing_model.md)\n\n",
                tp.box_cycles, tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
@@ -309,7 +337,10 @@ int cmd_trace(int argc, char **argv) {
                : fmt == CBVH_FORMAT_QBVH ? (main_r->frames > 1 ? " (QBVH: SAH build + 4-ary collapse; refits: the QBVH's "
                                                                    "own boxes bottom-up, topology kept)"
                                                                  : " (QBVH: SAH build + 4-ary collapse)")
-                                         : " (SAH build)");
+                                         : fmt == CBVH_FORMAT_TLIST
+                                             ? (main_r->frames > 1 ? " (sphere hierarchy + lists, rebuilt per frame)"
+                                                                   : " (sphere hierarchy + lists)")
+                                             : " (SAH build)");
         if (fmt == CBVH_FORMAT_QBVH)
             printf("qbvh stack unit: %llu sort+push, %llu pop operations; deepest stack %u entries (float BVH %u)\n",
                    (unsigned long long)tm.st.qstack_pushes, (unsigned long long)tm.st.qstack_pops, tm.st.max_stack,
@@ -320,7 +351,7 @@ int cmd_trace(int argc, char **argv) {
     }
     if (status)
         fprintf(stderr, "cbvh trace: %s hits differ from the float BVH (a traversal bug)\n",
-                fmt == CBVH_FORMAT_QBVH ? "QBVH" : "CBVH");
+                fmt == CBVH_FORMAT_QBVH ? "QBVH" : fmt == CBVH_FORMAT_TLIST ? "traversal-list" : "CBVH");
     cbvh_scene_desc_free(&d);
     return status;
 }

@@ -69,7 +69,7 @@ static void cosine_dir(rng *r, const float n[3], float out[3]) {
     for (int i = 0; i < 3; i++) out[i] = x * t[i] + y * b[i] + z * n[i];
 }
 
-/* ---- the accelerator: float BVH, CBVH or QBVH ---- */
+/* ---- the accelerator: float BVH, CBVH, QBVH or traversal lists ---- */
 typedef struct {
     const cbvh_scene_desc *d;
     const cbvh_fx_opts *o;
@@ -79,6 +79,11 @@ typedef struct {
     int have_tree;
     cbvh_qbvh qbvh;
     int have_qbvh;
+    cbvh_bsh bsh;
+    cbvh_tlists tl;
+    int have_tl;
+    uint32_t *cell_head; /* pinhole primary rays: per screen cell, per list */
+    int cell_w, cell_h;  /* cell size in pixels */
     cbvh_tri *tris; /* current frame */
     float eps;      /* secondary-ray origin offset along the normal */
     int frame;
@@ -91,6 +96,19 @@ static double cpu_now(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Where a ray starts in list l (docs/tlist.md §7): a camera ray of a pinhole
+ * camera at its screen cell's head; a secondary ray at its source triangle's
+ * head when it leaves on the front side; else the list's start. */
+static uint32_t tlist_head(const tracer *T, const cbvh_ray *r, int l, uint32_t src) {
+    const cbvh_tlists *L = &T->tl;
+    if (src == UINT32_MAX) {
+        if (!T->cell_head) return 0;
+        int cx = T->px / T->cell_w, cy = T->py / T->cell_h, ncx = (T->d->camera.width + T->cell_w - 1) / T->cell_w;
+        return T->cell_head[((size_t)cy * (size_t)ncx + (size_t)cx) * CBVH_TLIST_MAX + (size_t)l];
+    }
+    return T->o->tlist.poly_heads ? cbvh_tlist_poly_head(L, l, src, T->tris, r) : 0;
+}
+
 static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3], const float dir[3], float tmax,
                  uint32_t src, int light, cbvh_trav_hit *hit) {
     cbvh_ray r;
@@ -101,16 +119,23 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
     r.tmin = 0;
     r.tmax = isinf(tmax) ? CBVH_F32_POS_INF : fbits(tmax);
     cbvh_trav_stats st = {0};
+    /* One-sided scenes: the same rule on every format (the reference included). */
+    cbvh_trav_mode tm = T->o->one_sided ? (cbvh_trav_mode)(mode | CBVH_TRAV_FRONT_ONLY) : mode;
     double t0 = cpu_now();
-    int rc = T->o->format == CBVH_FORMAT_CBVH ? cbvh_trace_cbvh(&T->tree, T->tris, &r, T->o->mant, mode, hit, &st)
+    int rc;
+    if (T->o->format == CBVH_FORMAT_TLIST) {
+        int l = cbvh_tlist_pick(&T->tl, &r);
+        rc = cbvh_trace_tlist(&T->tl, l, tlist_head(T, &r, l, src), T->tris, &r, tm, hit, &st);
+    } else
+        rc = T->o->format == CBVH_FORMAT_CBVH ? cbvh_trace_cbvh(&T->tree, T->tris, &r, T->o->mant, tm, hit, &st)
              : T->o->format == CBVH_FORMAT_QBVH
-                 ? cbvh_trace_qbvh(&T->qbvh, T->tris, &r, T->o->mant, mode, CBVH_QSTACK_COMPRESSED, hit, &st)
-                 : cbvh_trace_bvh(&T->bvh, T->tris, &r, T->o->mant, mode, hit, &st);
+                 ? cbvh_trace_qbvh(&T->qbvh, T->tris, &r, T->o->mant, tm, CBVH_QSTACK_COMPRESSED, hit, &st)
+                 : cbvh_trace_bvh(&T->bvh, T->tris, &r, T->o->mant, tm, hit, &st);
     double t1 = cpu_now();
     cbvh_fx_stats *s = &T->res->fx[fx];
     s->cpu_seconds += t1 - t0;
     s->rays++;
-    if (mode == CBVH_TRAV_ANY)
+    if (mode & CBVH_TRAV_ANY)
         s->any++;
     else
         s->closest++;
@@ -128,13 +153,16 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
     s->st.qstack_pushes += st.qstack_pushes;
     s->st.qstack_pops += st.qstack_pops;
     cbvh_unit_activity *u = &T->res->units;
-    u->ray_box += st.box_tests;
+    if (T->o->format == CBVH_FORMAT_TLIST)
+        u->ray_sphere += st.box_tests; /* the lists' "box tests" are sphere tests */
+    else
+        u->ray_box += st.box_tests;
     u->ray_triangle += st.tri_tests;
     if (T->o->format == CBVH_FORMAT_CBVH) u->decoder += 6 * st.nodes;
     u->qbvh_stack += st.qstack_pushes + st.qstack_pops;
     /* Closest hit: triangle and t are defined (same on every format); any hit: only whether. */
     uint64_t h = T->res->hit_digest ^
-                 (!hit->hit ? 0xFFFFFFFFFFFFFFFFu : mode == CBVH_TRAV_ANY ? 1 : ((uint64_t)hit->prim << 32 | hit->t));
+                 (!hit->hit ? 0xFFFFFFFFFFFFFFFFu : (mode & CBVH_TRAV_ANY) ? 1 : ((uint64_t)hit->prim << 32 | hit->t));
     T->res->hit_digest = mix64(h + (uint64_t)fx);
     if (T->o->on_ray) {
         cbvh_fx_ray fr = {fx, mode, r, src, light, T->frame, hit, &st, T->px, T->py};
@@ -208,15 +236,30 @@ static void shade(tracer *T, rng *R, const float o[3], const float dir[3], const
         }
 }
 
-/* Camera ray through pixel (x, y), sample s.  0 if the pixel has no ray
- * (fisheye outside its image circle). */
-static int camera_ray(const cbvh_camera *c, int x, int y, int spp, rng *R, float o[3], float dir[3]) {
-    float w[3], u[3], v[3];
+/* The camera's orthonormal frame: w forward, u right, v up. */
+static void camera_frame(const cbvh_camera *c, float w[3], float u[3], float v[3]) {
     sub3(w, c->target, c->position);
     norm3(w);
     cross3(u, w, c->up);
     norm3(u);
     cross3(v, u, w);
+}
+
+/* The pinhole direction through image point (px, py) in [0, 1]^2 (the
+ * formula of camera_ray). */
+static void pinhole_dir(const cbvh_camera *c, float px, float py, float dir[3]) {
+    float w[3], u[3], v[3];
+    camera_frame(c, w, u, v);
+    float th = tanf(0.5f * c->fov * PI_F / 180.0f), aspect = (float)c->width / (float)c->height;
+    float sx = (2 * px - 1) * th * aspect, sy = (1 - 2 * py) * th;
+    for (int i = 0; i < 3; i++) dir[i] = w[i] + sx * u[i] + sy * v[i];
+}
+
+/* Camera ray through pixel (x, y), sample s.  0 if the pixel has no ray
+ * (fisheye outside its image circle). */
+static int camera_ray(const cbvh_camera *c, int x, int y, int spp, rng *R, float o[3], float dir[3]) {
+    float w[3], u[3], v[3];
+    camera_frame(c, w, u, v);
     float jx = spp > 1 ? rnd(R) : 0.5f, jy = spp > 1 ? rnd(R) : 0.5f;
     float px = ((float)x + jx) / (float)c->width, py = ((float)y + jy) / (float)c->height; /* [0,1) */
     memcpy(o, c->position, 3 * sizeof(float));
@@ -233,9 +276,7 @@ static int camera_ray(const cbvh_camera *c, int x, int y, int spp, rng *R, float
             dir[i] = cosf(th) * w[i] + sinf(th) * (cosf(ph) * u[i] + sinf(ph) * v[i]);
         return 1;
     }
-    float th = tanf(0.5f * c->fov * PI_F / 180.0f), aspect = (float)c->width / (float)c->height;
-    float sx = (2 * px - 1) * th * aspect, sy = (1 - 2 * py) * th;
-    for (int i = 0; i < 3; i++) dir[i] = w[i] + sx * u[i] + sy * v[i];
+    pinhole_dir(c, px, py, dir);
     if (c->type == CBVH_CAM_THIN_LENS) {
         /* Point in focus at distance focus_distance along the axis; origin on
          * the lens disk of radius `aperture`. */
@@ -321,7 +362,115 @@ static int qbvh_children_after_parent(const cbvh_qbvh *q) {
 }
 
 const char *cbvh_format_name(cbvh_accel_format f) {
-    return f == CBVH_FORMAT_CBVH ? "cbvh" : f == CBVH_FORMAT_QBVH ? "qbvh" : "float";
+    return f == CBVH_FORMAT_CBVH ? "cbvh" : f == CBVH_FORMAT_QBVH ? "qbvh" : f == CBVH_FORMAT_TLIST ? "tlist" : "float";
+}
+
+int cbvh_tlist_opts_parse(const char *s, cbvh_tlist_opts *t, char *err, size_t errlen) {
+    memset(t, 0, sizeof *t);
+    t->p.nlists = 6;
+    t->p.order = CBVH_TLIST_EARLIEST_FIRST;
+    char buf[128];
+    if (strncmp(s, "tlist", 5) != 0 || (s[5] && s[5] != ':') || strlen(s) >= sizeof buf) {
+        snprintf(err, errlen, "format '%s': expected tlist[:1|2|6|8][:earliest|:latest][:cull][:heads]", s);
+        return -1;
+    }
+    snprintf(buf, sizeof buf, "%s", s + 5);
+    /* Split on ':' by hand: callers may be inside their own strtok loop. */
+    for (char *k = buf[0] ? buf + 1 : NULL, *next; k; k = next) {
+        next = strchr(k, ':');
+        if (next) *next++ = 0;
+        if (strcmp(k, "1") == 0 || strcmp(k, "2") == 0 || strcmp(k, "6") == 0 || strcmp(k, "8") == 0)
+            t->p.nlists = k[0] - '0';
+        else if (strcmp(k, "earliest") == 0)
+            t->p.order = CBVH_TLIST_EARLIEST_FIRST;
+        else if (strcmp(k, "latest") == 0)
+            t->p.order = CBVH_TLIST_LATEST_LAST;
+        else if (strcmp(k, "cull") == 0)
+            t->p.cull_back = 1;
+        else if (strcmp(k, "heads") == 0)
+            t->poly_heads = t->cell_heads = 1;
+        else {
+            snprintf(err, errlen, "format '%s': unknown tlist option '%s' (lists 1|2|6|8, earliest|latest, cull, heads)",
+                     s, k);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+void cbvh_tlist_opts_name(const cbvh_tlist_opts *t, char *out, size_t n) {
+    snprintf(out, n, "tlist:%d:%s%s%s", t->p.nlists ? t->p.nlists : 6,
+             t->p.order == CBVH_TLIST_LATEST_LAST ? "latest" : "earliest", t->p.cull_back ? ":cull" : "",
+             t->poly_heads || t->cell_heads ? ":heads" : "");
+}
+
+/* Per-screen-cell heads for a pinhole camera: the image split into at most
+ * 16 x 16 cells, each cell's primary rays bounded by the cone of its four
+ * corner directions (widened by 2^-16 rad for the float rounding of pixel
+ * directions). */
+static int build_cell_heads(tracer *T, char *err, size_t errlen) {
+    const cbvh_camera *c = &T->d->camera;
+    free(T->cell_head);
+    T->cell_head = NULL;
+    if (!T->o->tlist.cell_heads || c->type != CBVH_CAM_PINHOLE) return 0;
+    T->cell_w = (c->width + 15) / 16;
+    T->cell_h = (c->height + 15) / 16;
+    int ncx = (c->width + T->cell_w - 1) / T->cell_w, ncy = (c->height + T->cell_h - 1) / T->cell_h;
+    T->cell_head = calloc((size_t)ncx * (size_t)ncy * CBVH_TLIST_MAX, sizeof *T->cell_head);
+    if (!T->cell_head) abort();
+    for (int cy = 0; cy < ncy; cy++)
+        for (int cx = 0; cx < ncx; cx++) {
+            int x0 = cx * T->cell_w, y0 = cy * T->cell_h;
+            int x1 = x0 + T->cell_w < c->width ? x0 + T->cell_w : c->width;
+            int y1 = y0 + T->cell_h < c->height ? y0 + T->cell_h : c->height;
+            float corner[4][3];
+            const float X[4] = {(float)x0, (float)x1, (float)x1, (float)x0}, Y[4] = {(float)y0, (float)y0, (float)y1, (float)y1};
+            for (int k = 0; k < 4; k++) pinhole_dir(c, X[k] / (float)c->width, Y[k] / (float)c->height, corner[k]);
+            if (cbvh_tlist_cell_heads(&T->tl, T->tris, c->position, corner, 0x1p-16,
+                                      &T->cell_head[((size_t)cy * (size_t)ncx + (size_t)cx) * CBVH_TLIST_MAX])) {
+                snprintf(err, errlen, "tlist: cannot compute the screen-cell heads (non-finite camera)");
+                return -1;
+            }
+        }
+    return 0;
+}
+
+/* (Re)builds the sphere hierarchy and the lists for the current frame. */
+static int build_tlists(tracer *T, char *err, size_t errlen) {
+    if (T->have_tl) {
+        cbvh_tlists_free(&T->tl);
+        cbvh_bsh_free(&T->bsh);
+        T->have_tl = 0;
+    }
+    cbvh_scene sc = T->d->mesh;
+    sc.tris = T->tris;
+    sc.nmorph = 0;
+    sc.nkeys = 0;
+    cbvh_bsh_params bp;
+    cbvh_bsh_default_params(&bp);
+    if (cbvh_bsh_build(&sc, &bp, &T->bsh, err, errlen)) return -1;
+    cbvh_tlist_params lp = T->o->tlist.p;
+    if (!lp.nlists) lp.nlists = 6;
+    if (cbvh_tlists_build(&T->bsh, &sc, &lp, &T->tl, err, errlen)) {
+        cbvh_bsh_free(&T->bsh);
+        return -1;
+    }
+    T->have_tl = 1;
+    if (T->o->tlist.poly_heads) {
+        /* Secondary rays start at q = hit point + eps n: the margin covers eps
+         * and the hit point's rounding (docs/tlist.md §7.1). */
+        const cbvh_camera *c = &T->d->camera;
+        float cmax = 0;
+        for (uint32_t i = 0; i < sc.ntris; i++)
+            for (int v = 0; v < 3; v++)
+                for (int a = 0; a < 3; a++) cmax = fmaxf(cmax, fabsf(sc.tris[i].v[v][a]));
+        cmax += T->eps;
+        for (int a = 0; a < 3; a++) cmax = fmaxf(cmax, fabsf(c->position[a]) + fabsf(c->aperture));
+        if (cbvh_tlists_poly_heads(&T->tl, T->tris, CBVH_TLIST_HEADS_REGULAR, cbvh_tlist_hitpoint_margin(T->eps, cmax),
+                                   err, errlen))
+            return -1;
+    }
+    return build_cell_heads(T, err, errlen);
 }
 
 int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen) {
@@ -350,7 +499,7 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     if (!(T.eps > 0)) T.eps = 1e-6f;
     int rc = -1;
     double b0 = cpu_now();
-    if (cbvh_build_sah(&frame0, 0, 0, &T.bvh, err, errlen)) {
+    if (o->format != CBVH_FORMAT_TLIST && cbvh_build_sah(&frame0, 0, 0, &T.bvh, err, errlen)) {
         free(T.tris);
         return -1;
     }
@@ -366,6 +515,13 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
             goto out;
         }
         r->node_bytes = cbvh_qbvh_node_bytes(&T.qbvh) + (uint64_t)T.qbvh.nprims * 4u;
+    } else if (o->format == CBVH_FORMAT_TLIST) {
+        if (o->tlist.p.cull_back && !o->one_sided) {
+            snprintf(err, errlen, "tlist: back-face culling needs one-sided triangles (--one-sided)");
+            goto out;
+        }
+        if (build_tlists(&T, err, errlen)) goto out;
+        r->node_bytes = cbvh_tlists_bytes(&T.tl);
     } else
         r->node_bytes = cbvh_bvh_bytes(&T.bvh);
     r->build_cpu_seconds = cpu_now() - b0;
@@ -379,7 +535,10 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
                 r->units.refit += T.bvh.nnodes;
             } else if (o->format == CBVH_FORMAT_QBVH)
                 r->units.refit += qbvh_refit(&T.qbvh, T.tris); /* the QBVH's boxes, same topology */
-            else {
+            else if (o->format == CBVH_FORMAT_TLIST) {
+                if (build_tlists(&T, err, errlen)) goto out; /* lists are not updatable: rebuilt */
+                r->units.refit += T.bsh.nnodes;
+            } else {
                 cbvh_bvh_refit(&T.bvh, T.tris);
                 r->units.refit += T.bvh.nnodes;
             }
@@ -392,6 +551,11 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
 out:
     if (T.have_tree) cbvh_tree_free(&T.tree);
     if (T.have_qbvh) cbvh_qbvh_free(&T.qbvh);
+    if (T.have_tl) {
+        cbvh_tlists_free(&T.tl);
+        cbvh_bsh_free(&T.bsh);
+    }
+    free(T.cell_head);
     cbvh_bvh_free(&T.bvh);
     free(T.tris);
     return rc;

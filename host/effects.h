@@ -10,16 +10,32 @@
 #include <stdint.h>
 
 #include "cbvh/qbvh.h"
+#include "cbvh/tlist.h"
 #include "cbvh/traverse.h"
 #include "scene_file.h"
 #include "timing_model.h"
 
 /* QBVH: the same binned-SAH float BVH collapsed to 4-ary (docs/qbvh.md),
- * traversed with the compressed 32-bit stack. */
-typedef enum { CBVH_FORMAT_FLOAT = 0, CBVH_FORMAT_CBVH = 1, CBVH_FORMAT_QBVH = 2 } cbvh_accel_format;
+ * traversed with the compressed 32-bit stack.  TLIST: the stackless
+ * traversal lists over a bounding-sphere hierarchy (docs/tlist.md). */
+typedef enum { CBVH_FORMAT_FLOAT = 0, CBVH_FORMAT_CBVH = 1, CBVH_FORMAT_QBVH = 2, CBVH_FORMAT_TLIST = 3 } cbvh_accel_format;
 
-/* "float", "cbvh", "qbvh". */
+/* "float", "cbvh", "qbvh", "tlist". */
 const char *cbvh_format_name(cbvh_accel_format f);
+
+/* The options of the traversal-list format. */
+typedef struct {
+    cbvh_tlist_params p; /* lists, order, back-face culling */
+    int poly_heads;      /* per-polygon list heads for secondary rays */
+    int cell_heads;      /* per-screen-cell list heads for pinhole primary rays */
+} cbvh_tlist_opts;
+
+/* Parses "tlist[:L][:earliest|:latest][:cull][:heads]" (L = 1, 2, 6, 8;
+ * defaults 6 lists, earliest first, no culling, no heads; "heads" = both kinds).
+ * 0, or -1 with a one-line reason. */
+int cbvh_tlist_opts_parse(const char *s, cbvh_tlist_opts *t, char *err, size_t errlen);
+/* The canonical spelling of the options, e.g. "tlist:6:earliest:cull:heads". */
+void cbvh_tlist_opts_name(const cbvh_tlist_opts *t, char *out, size_t n);
 
 /* One traced ray, as the observer sees it. */
 typedef struct {
@@ -42,6 +58,8 @@ typedef struct {
     void (*on_ray)(void *ctx, const cbvh_fx_ray *r);       /* optional observer */
     void (*progress)(void *ctx, int frame, int frames, int row, int rows); /* optional */
     void *ctx;
+    cbvh_tlist_opts tlist; /* format tlist (zeroed: the defaults of cbvh_tlist_opts_parse("tlist")) */
+    int one_sided;         /* triangles count only from their front side (cbvh_tri_facing), every format */
 } cbvh_fx_opts;
 
 typedef struct {
@@ -61,6 +79,7 @@ typedef struct {
     uint64_t ray_triangle; /* ray-triangle tests */
     uint64_t refit;        /* node boxes recomputed by refits (animated scenes only) */
     uint64_t qbvh_stack;   /* QBVH stack unit operations: sort + push (one per inner node visited) and pops */
+    uint64_t ray_sphere;   /* ray-sphere tests (format tlist; its box_tests counter counts these) */
 } cbvh_unit_activity;
 
 typedef struct {
@@ -76,10 +95,12 @@ typedef struct {
 } cbvh_fx_result;
 
 /* Builds the float BVH (binned SAH) of frame 0, compresses it (format cbvh,
- * bottom-up streaming) or collapses it to a QBVH (format qbvh), and for every
- * frame: refits (frames >= 1; the QBVH's own boxes are refitted bottom-up,
- * its topology kept), then traces every enabled effect.  0, or -1 with a
- * one-line reason. */
+ * bottom-up streaming), collapses it to a QBVH (format qbvh) or builds the
+ * sphere hierarchy and its lists (format tlist), and for every frame: refits
+ * (frames >= 1; the QBVH's own boxes are refitted bottom-up, its topology
+ * kept; the lists are rebuilt, since culling and heads depend on the
+ * triangles' normals and positions), then traces every enabled effect.  0,
+ * or -1 with a one-line reason. */
 int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen);
 
 /* Sum over the effects of a result (max_stack = the deepest). */

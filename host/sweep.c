@@ -61,7 +61,7 @@ static void on_ray(void *vctx, const cbvh_fx_ray *fr) {
     uint64_t i = c->n++;
     cbvh_trav_hit h = *fr->hit;
     if (c->setting >= 0 && c->setting == c->o->corrupt_setting && i == c->o->corrupt_ray) {
-        if (fr->mode == CBVH_TRAV_CLOSEST && h.hit)
+        if (!(fr->mode & CBVH_TRAV_ANY) && h.hit)
             h.t ^= 1; /* one ulp off */
         else
             h.hit = !h.hit;
@@ -95,7 +95,7 @@ static void on_ray(void *vctx, const cbvh_fx_ray *fr) {
             snprintf(what, sizeof what, "a false miss (float BVH hits triangle %u)", r->prim);
         else if (!r->hit && hit)
             snprintf(what, sizeof what, "a false hit on triangle %u (float BVH misses)", h.prim);
-        else if (hit && fr->mode == CBVH_TRAV_CLOSEST && (r->prim != h.prim || r->t != h.t))
+        else if (hit && !(fr->mode & CBVH_TRAV_ANY) && (r->prim != h.prim || r->t != h.t))
             snprintf(what, sizeof what, "triangle %u t=0x%08x, float BVH triangle %u t=0x%08x", h.prim, h.t, r->prim,
                      r->t);
     }
@@ -118,7 +118,8 @@ static void on_progress(void *vctx, int frame, int frames, int row, int rows) {
     if (c->o->progress) c->o->progress(c->o->ctx, c->label, c->setting + 1, c->nsettings, row, rows);
 }
 
-static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, char *err, size_t errlen) {
+static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, const cbvh_tlist_opts *tl, char *err,
+                   size_t errlen) {
     size_t npx = (size_t)c->d->camera.width * (size_t)c->d->camera.height;
     run->box_px = xcalloc(npx, sizeof *run->box_px);
     run->image = xcalloc(npx, 1);
@@ -126,8 +127,15 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, c
     c->run = run;
     c->n = 0;
     run->same = 1;
-    cbvh_fx_opts fo = {fmt, {run->s.bits ? run->s.bits : 6, run->s.min_scale}, run->s.mant, c->o->spp, on_ray,
-                       on_progress, c};
+    cbvh_fx_opts fo = {.format = fmt,
+                       .params = {run->s.bits ? run->s.bits : 6, run->s.min_scale},
+                       .mant = run->s.mant,
+                       .spp = c->o->spp,
+                       .on_ray = on_ray,
+                       .progress = on_progress,
+                       .ctx = c};
+    if (tl) fo.tlist = *tl;
+    fo.one_sided = c->o->one_sided;
     int rc = cbvh_fx_run(c->d, &fo, &run->r, err, errlen);
     for (size_t p = 0; p < npx; p++) {
         double v = floor(c->shade[p] + 0.5);
@@ -163,6 +171,10 @@ static void check_totals(const sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_sweep_r
 int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_sweep_result *res, char *err,
                    size_t errlen) {
     memset(res, 0, sizeof *res);
+    if (o->nextra < 0 || o->nextra > CBVH_SWEEP_MAX_EXTRA) {
+        snprintf(err, errlen, "at most %d other formats", CBVH_SWEEP_MAX_EXTRA);
+        return -1;
+    }
     if (o->bits_lo < CBVH_N_MIN || o->bits_hi > CBVH_N_MAX || o->bits_lo > o->bits_hi) {
         snprintf(err, errlen, "--bits range %d..%d not within %d..%d", o->bits_lo, o->bits_hi, CBVH_N_MIN, CBVH_N_MAX);
         return -1;
@@ -196,11 +208,11 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
 
     cbvh_tri *tris0 = xcalloc(d->mesh.ntris, sizeof *tris0);
     cbvh_scene_desc_frame(d, 0, tris0);
-    sweep_ctx c = {.d = d, .o = o, .tris0 = tris0, .setting = -1, .nsettings = res->nrows + (o->qbvh != 0), .label = "float",
+    sweep_ctx c = {.d = d, .o = o, .tris0 = tris0, .setting = -1, .nsettings = res->nrows + o->nextra, .label = "float",
                    .spp = res->spp};
     int rc = -1;
     res->ref.s = (cbvh_sweep_setting){0, CBVH_MANT_MAX, o->min_scale[0]};
-    if (run_one(&c, &res->ref, CBVH_FORMAT_FLOAT, err, errlen)) goto out;
+    if (run_one(&c, &res->ref, CBVH_FORMAT_FLOAT, NULL, err, errlen)) goto out;
     res->ref_rays = c.nrec;
     res->all_same = 1;
     char label[48];
@@ -209,17 +221,21 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
         snprintf(label, sizeof label, "N=%d M=%d E=%d", run->s.bits, run->s.mant, run->s.min_scale);
         c.setting = i;
         c.label = label;
-        if (run_one(&c, run, CBVH_FORMAT_CBVH, err, errlen)) goto out;
+        if (run_one(&c, run, CBVH_FORMAT_CBVH, NULL, err, errlen)) goto out;
         check_totals(&c, run, res);
     }
-    if (o->qbvh) {
-        cbvh_sweep_run_t *run = &res->qbvh;
-        res->have_qbvh = 1;
+    for (int k = 0; k < o->nextra; k++) {
+        const cbvh_sweep_format *f = &o->extra[k];
+        cbvh_sweep_run_t *run = &res->extra[k];
+        res->nextra = k + 1;
         run->s = (cbvh_sweep_setting){0, o->mant[0], o->min_scale[0]};
-        snprintf(label, sizeof label, "qbvh M=%d", run->s.mant);
-        c.setting = res->nrows;
+        if (f->format == CBVH_FORMAT_QBVH)
+            snprintf(label, sizeof label, "%s M=%d", f->name, run->s.mant);
+        else
+            snprintf(label, sizeof label, "%s", f->name);
+        c.setting = res->nrows + k;
         c.label = label;
-        if (run_one(&c, run, CBVH_FORMAT_QBVH, err, errlen)) goto out;
+        if (run_one(&c, run, f->format, &f->tlist, err, errlen)) goto out;
         check_totals(&c, run, res);
     }
     rc = 0;
@@ -238,8 +254,10 @@ void cbvh_sweep_free(cbvh_sweep_result *res) {
         free(res->rows[i].image);
     }
     free(res->rows);
-    free(res->qbvh.box_px);
-    free(res->qbvh.image);
+    for (int k = 0; k < res->nextra; k++) {
+        free(res->extra[k].box_px);
+        free(res->extra[k].image);
+    }
     memset(res, 0, sizeof *res);
 }
 

@@ -3,8 +3,9 @@
  * minimum scale E), on the same rays in one run, and prove every setting
  * returns the float BVH's hits ray by ray (same triangle and t bits for
  * closest-hit rays, same answer for any-hit rays: no false misses) and renders
- * the same image.  Optionally the QBVH (docs/qbvh.md) is traced on the same
- * rays as one more row (it has no N) and checked the same way.  The output side (table, JSON, chart, heat maps) is
+ * the same image.  Optionally other formats — the QBVH (docs/qbvh.md), the
+ * traversal lists (docs/tlist.md) — are traced on the same rays as more rows
+ * (they have no N) and checked the same way.  The output side (table, JSON, chart, heat maps) is
  * host/cmd_sweep.c. */
 #ifndef CBVH_HOST_SWEEP_H
 #define CBVH_HOST_SWEEP_H
@@ -17,6 +18,14 @@
 #include "timing_model.h"
 
 #define CBVH_SWEEP_MAX_LIST 16 /* values of --mant and of --min-scale */
+#define CBVH_SWEEP_MAX_EXTRA 12 /* other formats (--formats) */
+
+/* One more format traced after the CBVH settings, at the first M. */
+typedef struct {
+    cbvh_accel_format format; /* CBVH_FORMAT_QBVH or CBVH_FORMAT_TLIST */
+    cbvh_tlist_opts tlist;    /* format tlist */
+    char name[48];            /* "qbvh", "tlist:6:earliest:cull:heads", ... */
+} cbvh_sweep_format;
 
 typedef struct {
     int bits; /* N; 0 = the float BVH */
@@ -29,9 +38,11 @@ typedef struct {
     int mant[CBVH_SWEEP_MAX_LIST], nmant;
     int min_scale[CBVH_SWEEP_MAX_LIST], nmin_scale;
     int spp; /* 0 = the scene's */
-    int qbvh; /* also trace the QBVH (ray-box unit M = mant[0]): the row after the CBVH settings */
-    /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows =
-     * the QBVH row, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
+    cbvh_sweep_format extra[CBVH_SWEEP_MAX_EXTRA]; /* traced after the CBVH settings (M = mant[0]) */
+    int nextra;
+    int one_sided; /* triangles count only from their front side, every format (required by tlist culling) */
+    /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows +
+     * k = extra format k, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
      * for a closest hit, the opposite answer for an any-hit ray). */
     int corrupt_setting;
     uint64_t corrupt_ray;
@@ -59,9 +70,9 @@ typedef struct {
     cbvh_sweep_run_t ref; /* float BVH */
     cbvh_sweep_run_t *rows; /* nrows CBVH settings: for each M, each E, each N ascending */
     int nrows;
-    int have_qbvh;
-    cbvh_sweep_run_t qbvh; /* the QBVH row (s.bits = 0, s.mant = its M) when have_qbvh */
-    int all_same; /* every CBVH setting and the QBVH */
+    int nextra;
+    cbvh_sweep_run_t extra[CBVH_SWEEP_MAX_EXTRA]; /* the other formats' rows (s.bits = 0, s.mant = M) */
+    int all_same; /* every CBVH setting and every other format */
 } cbvh_sweep_result;
 
 /* 0, or -1 with a one-line reason (bad option, build failure). */

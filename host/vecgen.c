@@ -886,6 +886,138 @@ static void gen_ray_triangle(gen_t *g, size_t target) {
     }
 }
 
+/* ---- ray_sphere (docs/traversal.md §10) ------------------------------------------ */
+
+/* Input words: o[3] d[3] tmin tmax, then cx cy cz r. */
+static void emit_ray_sphere(gen_t *g, const cbvh_f32 o[3], const cbvh_f32 d[3], cbvh_f32 tmin, cbvh_f32 tmax,
+                            const cbvh_f32 c[3], cbvh_f32 r) {
+    uint32_t in[12];
+    for (int a = 0; a < 3; a++) {
+        in[a] = o[a];
+        in[3 + a] = d[a];
+        in[8 + a] = c[a];
+    }
+    in[6] = tmin;
+    in[7] = tmax;
+    in[11] = r;
+    emit(g, in);
+}
+
+/* n * 2^e exactly (|n| < 2^24 and the value in range: the callers ensure it). */
+static cbvh_f32 dyadic(int64_t n, int e) { return cbvh_f32_add_dyadic(n, e, 0, 0, CBVH_RND_DOWN); }
+
+static void gen_ray_sphere(gen_t *g, size_t target) {
+    if (!g->random_only) {
+        /* the unit sphere at the origin; rays along +-x at heights y through the
+         * centre, inside, tangent (y = 1) and one ulp either side of it */
+        static const cbvh_f32 ys[] = {0, CBVH_F32_SIGN, F_HALF, F_ONE, 0x3F800001u, 0x3F7FFFFFu, 0xBF800000u,
+                                      0x00000001u};
+        static const cbvh_f32 xs[] = {0xC0A00000u /* -5 */, 0xBF800000u /* on the surface */, 0, 0x40A00000u};
+        /* segments: unbounded, ending at the tangent point x = 0 and just before, a point, empty */
+        static const cbvh_f32 ts[][2] = {{0, CBVH_F32_POS_INF},
+                                         {0, 0x40A00000u /* 5 */},
+                                         {0, 0x409FFFFFu},
+                                         {0x40A00000u, CBVH_F32_POS_INF},
+                                         {0x40A00001u, CBVH_F32_POS_INF},
+                                         {0x40800000u /* 4 */, 0x40800000u},
+                                         {CBVH_F32_MAX | CBVH_F32_SIGN, CBVH_F32_POS_INF},
+                                         {0x40000000u, F_ONE /* empty */}};
+        const cbvh_f32 c0[3] = {0, 0, 0};
+        for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++)
+            for (size_t j = 0; j < sizeof ys / sizeof ys[0]; j++)
+                for (size_t k = 0; k < sizeof ts / sizeof ts[0]; k++)
+                    for (int sgn = 0; sgn < 2; sgn++) {
+                        const cbvh_f32 o[3] = {xs[i], ys[j], 0}, d[3] = {sgn ? 0xBF800000u : F_ONE, 0, 0};
+                        emit_ray_sphere(g, o, d, ts[k][0], ts[k][1], c0, F_ONE);
+                    }
+        /* radii: 0, -0 (a point), subnormal, 2^127, FLT_MAX; direction patterns as the box unit's */
+        static const cbvh_f32 rs[] = {0, CBVH_F32_SIGN, 0x00000001u, 0x7F000000u, CBVH_F32_MAX};
+        for (size_t i = 0; i < sizeof rs / sizeof rs[0]; i++)
+            for (int j = 0; j < N_RB_DIR; j++) {
+                cbvh_f32 o[3] = {rb_orig[j], 0x40000000u, F_HALF}, d[3] = {rb_dir[j], rb_dir[(j + 1) % N_RB_DIR],
+                                                                         rb_dir[(j + 3) % N_RB_DIR]};
+                if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1]) && cbvh_f32_is_zero(d[2])) d[2] = F_ONE;
+                const cbvh_f32 c[3] = {F_HALF, F_HALF, F_HALF};
+                emit_ray_sphere(g, o, d, 0, CBVH_F32_POS_INF, c, rs[i]);
+                emit_ray_sphere(g, o, d, 0, F_TWO24, c, rs[i]);
+            }
+        /* exact tangents in 3D (d . w = 0, |w| = r integer), scaled to huge and tiny
+         * exponents, with the tangent point at tmin, at tmax, and one ulp off */
+        static const int perp[][7] = {{3, 4, 12, 4, -3, 0, 5}, {1, 2, 2, 2, 1, -2, 3}, {2, 3, 6, 3, -6, 2, 7},
+                                      {1, 4, 8, 4, 7, -4, 9}};
+        static const int scales[][2] = {{0, 0}, {-20, 3}, {90, -10}, {-149, -149}, {-100, 0}, {60, 60}, {-140, -40}};
+        for (size_t p = 0; p < sizeof perp / sizeof perp[0]; p++)
+            for (size_t sc = 0; sc < sizeof scales / sizeof scales[0]; sc++) {
+                int es = scales[sc][0], ed = scales[sc][1], m = 3;
+                cbvh_f32 o[3], d[3], c[3];
+                for (int a = 0; a < 3; a++) {
+                    int64_t C = 100 * (a + 1);
+                    c[a] = dyadic(C, es);
+                    o[a] = dyadic(C - perp[p][3 + a] - m * perp[p][a], es);
+                    d[a] = dyadic(perp[p][a], ed);
+                }
+                cbvh_f32 r = dyadic(perp[p][6], es), tm = dyadic(m, es - ed);
+                emit_ray_sphere(g, o, d, 0, CBVH_F32_POS_INF, c, r);
+                emit_ray_sphere(g, o, d, 0, tm, c, r);
+                emit_ray_sphere(g, o, d, 0, down(tm), c, r);
+                emit_ray_sphere(g, o, d, tm, CBVH_F32_POS_INF, c, r);
+                emit_ray_sphere(g, o, d, up(tm), CBVH_F32_POS_INF, c, r);
+                emit_ray_sphere(g, o, d, 0, CBVH_F32_POS_INF, c, down(r));
+                emit_ray_sphere(g, o, d, 0, CBVH_F32_POS_INF, c, up(r));
+            }
+        /* rejects: NaN/Inf in every port, zero direction, negative radius */
+        const cbvh_f32 o[3] = {0xC0A00000u, 0, 0}, d[3] = {F_ONE, 0, 0};
+        for (int k = 0; k < N_NAN_INF; k++)
+            for (int port = 0; port < 12; port++) {
+                cbvh_f32 oo[3] = {o[0], o[1], o[2]}, dd[3] = {d[0], d[1], d[2]}, c[3] = {0, 0, 0}, r = F_ONE,
+                         tmin = 0, tmax = CBVH_F32_POS_INF;
+                cbvh_f32 *w = port < 3    ? &oo[port]
+                              : port < 6  ? &dd[port - 3]
+                              : port == 6 ? &tmin
+                              : port == 7 ? &tmax
+                              : port < 11 ? &c[port - 8]
+                                          : &r;
+                *w = nan_inf[k];
+                emit_ray_sphere(g, oo, dd, tmin, tmax, c, r);
+            }
+        const cbvh_f32 dz[3] = {CBVH_F32_SIGN, 0, CBVH_F32_SIGN};
+        emit_ray_sphere(g, o, dz, 0, CBVH_F32_POS_INF, c0, F_ONE);
+        emit_ray_sphere(g, o, dz, 0, CBVH_F32_POS_INF, c0, 0xBF800000u);
+        emit_ray_sphere(g, o, d, 0, CBVH_F32_POS_INF, c0, 0x80000001u);
+        emit_ray_sphere(g, o, d, 0, CBVH_F32_POS_INF, c0, CBVH_F32_MAX | CBVH_F32_SIGN);
+    }
+    while (g->n < target && !g->oom) {
+        cbvh_f32 o[3], d[3], c[3], r;
+        uint64_t kind = rnd_below(&g->rng, 4);
+        if (kind == 0) { /* independent floats */
+            for (int a = 0; a < 3; a++) {
+                o[a] = rnd_float(&g->rng);
+                d[a] = rnd_float(&g->rng);
+                c[a] = rnd_float(&g->rng);
+            }
+            r = rnd_float(&g->rng) & ~CBVH_F32_SIGN;
+        } else { /* a scene-like sphere near the ray: aimed at it, past it, or anywhere */
+            int e = (int)rnd_range(&g->rng, -20, 20);
+            for (int a = 0; a < 3; a++) {
+                int64_t oi = rnd_range(&g->rng, -(1 << 20), 1 << 20);
+                int64_t off = rnd_range(&g->rng, -(1 << 20), 1 << 20);
+                int64_t dd = kind == 1   ? off + rnd_range(&g->rng, -(1 << 16), 1 << 16)
+                             : kind == 2 ? -off
+                                         : rnd_range(&g->rng, -(1 << 20), 1 << 20);
+                o[a] = dyadic(oi, e);
+                c[a] = dyadic(oi + off, e);
+                d[a] = dyadic(dd, (int)rnd_range(&g->rng, -30, 0));
+            }
+            r = dyadic(rnd_range(&g->rng, 0, 1 << 21), e);
+        }
+        if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1]) && cbvh_f32_is_zero(d[2])) d[0] = F_ONE;
+        uint64_t tk = rnd_below(&g->rng, 3);
+        cbvh_f32 tmin = tk == 0 ? rnd_float(&g->rng) : 0;
+        cbvh_f32 tmax = tk == 2 ? rnd_float(&g->rng) : CBVH_F32_POS_INF;
+        emit_ray_sphere(g, o, d, tmin, tmax, c, r);
+    }
+}
+
 /* ---- qbvh_stack (docs/qbvh.md §2) ------------------------------------------------ */
 
 static void emit_qstack(gen_t *g, uint32_t op, uint32_t first, uint32_t mask, const cbvh_f32 t[4], uint32_t entry) {
@@ -956,6 +1088,7 @@ static size_t level1_target(const cbvh_unit *u) {
     if (strcmp(u->name, "ray_box") == 0) return 1500;
     if (strcmp(u->name, "ray_triangle") == 0) return 1500;
     if (strcmp(u->name, "qbvh_stack") == 0) return 2000;
+    if (strcmp(u->name, "ray_sphere") == 0) return 1500;
     return 500;
 }
 
@@ -1000,6 +1133,7 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     else if (strcmp(s->unit->name, "ray_box") == 0) fn = gen_ray_box;
     else if (strcmp(s->unit->name, "ray_triangle") == 0) fn = gen_ray_triangle;
     else if (strcmp(s->unit->name, "qbvh_stack") == 0) fn = gen_qbvh_stack;
+    else if (strcmp(s->unit->name, "ray_sphere") == 0) fn = gen_ray_sphere;
     if (!fn) return -1;
     fn(&g, target);
     if (s->level >= 2) {

@@ -25,12 +25,35 @@
  *
  * Treelets of depth M: pairs within M-1 levels below the node being processed
  * are still on chip, so re-encoding them is free; only deeper re-encodes are
- * DRAM backtracks.  The output is identical for every M. */
+ * DRAM backtracks.  The output is identical for every M.
+ *
+ * Speed (docs/results.md, "Build throughput"); the output bits are those of
+ * the unit calls (tests/model/test_unit_fast.c, tests/build):
+ * - A node's estimated context is computed once, with its exact grid
+ *   coordinates k = floor(lb/2^e), ku = floor(ub/2^e) at its estimated scale
+ *   e (unit_fast.h), and kept on the context stack.
+ * - The parent's grid cs for that child is coarser or equal (the child box
+ *   lies in the parent's quantized box), and floor(floor(x/2^e)/2^(cs-e)) =
+ *   floor(x/2^cs), so the parent gets an inner child's codes and child scale
+ *   by two shifts instead of a compression (when cs == e they are the
+ *   child's own estimate).  Leaf children are floored directly.  Both use
+ *   the compressor's own integer steps.
+ * - The codes are packed straight into the pair (cbvh_fast_put_node).
+ * - Only a child whose context may have changed (modulo: its child scale
+ *   did; relative: also when its lower bound can have moved) gets its
+ *   actual context from the compressor unit and the specified comparison;
+ *   the decoded bounds clb = RD(k 2^e) are formed only there.
+ * - Leaves are emitted without a walk step of their own.
+ * Every input outside these cases (grid coordinates beyond 64 bits, a
+ * rejected or non-fitting box, a leaf root, a malformed tree) takes the
+ * general path, which calls the units exactly as specified. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cbvh_layout.h"
+#include "grid.h"
+#include "unit_fast.h"
 
 static int ctx_differs(cbvh_encoding enc, const cbvh_node_ctx *a, const cbvh_node_ctx *b) {
     for (int x = 0; x < 3; x++) {
@@ -140,6 +163,140 @@ static void box_of_inner(cbvh_bvh *b, uint32_t x) {
     }
 }
 
+/* A node's estimated context along one axis, as the stream keeps it.
+ * exact: k and ku are floor(lb/2^e) and floor(ub/2^e) of the node's box and
+ * lb_mod / cs come from them; clb is formed on demand.  Otherwise the
+ * context came from cbvh_axis_root_ctx and clb is stored. */
+typedef struct {
+    int64_t k, ku;
+    int e, cs; /* parent_scale, scale of the context */
+    uint32_t lb_mod;
+    cbvh_f32 clb;
+    int exact;
+} bu_axis;
+
+typedef struct {
+    bu_axis ax[3];
+} bu_rec;
+
+static inline cbvh_f32 axis_clb(const bu_axis *a) {
+    return a->exact ? cbvh_grid_pack_signed(a->k, a->e, CBVH_RND_DOWN) : a->clb;
+}
+
+static void rec_ctx(const bu_rec *r, cbvh_node_ctx *ctx) {
+    for (int a = 0; a < 3; a++)
+        ctx->axis[a] = (cbvh_axis_ctx){r->ax[a].e, r->ax[a].cs, r->ax[a].lb_mod, axis_clb(&r->ax[a])};
+}
+
+static void rec_of_ctx(const cbvh_node_ctx *ctx, bu_rec *r) {
+    memset(r, 0, sizeof *r);
+    for (int a = 0; a < 3; a++) {
+        const cbvh_axis_ctx *c = &ctx->axis[a];
+        r->ax[a].e = c->parent_scale;
+        r->ax[a].cs = c->scale;
+        r->ax[a].lb_mod = c->lb_mod;
+        r->ax[a].clb = c->clb;
+    }
+}
+
+/* Exact floor(lb/2^e), floor(ub/2^e) (0: a bound is beyond the kept range). */
+static inline int floor2(cbvh_f32 lb, cbvh_f32 ub, int e, int64_t *k, int64_t *ku) {
+    return cbvh_fast_floor(lb, e, k) & cbvh_fast_floor(ub, e, ku);
+}
+
+/* The estimated context of a box (cbvh_axis_root_ctx): 0, or a status. */
+static inline uint32_t est_axis(const cbvh_params *p, int n, int ms, cbvh_f32 lb, cbvh_f32 ub, bu_axis *ax) {
+    int e;
+    int r = cbvh_scale_estimate_fast_nm(n, ms, lb, ub, &e, &ax->k, &ax->ku);
+    if (r != 2) {
+        uint32_t st = r ? 0 : cbvh_scale_estimate(p, lb, ub, &e);
+        if (st || !floor2(lb, ub, e, &ax->k, &ax->ku)) {
+            cbvh_axis_ctx c;
+            st = cbvh_axis_root_ctx(p, lb, ub, &c);
+            *ax = (bu_axis){0, 0, c.parent_scale, c.scale, c.lb_mod, c.clb, 0};
+            return st;
+        }
+    }
+    uint32_t ub_mod;
+    ax->e = e;
+    ax->exact = 1;
+    /* fits by the choice of e; not fitting would be an estimator fault */
+    return cbvh_fast_code(n, ms, e, ax->k, ax->ku, &ax->lb_mod, &ub_mod, &ax->cs) ? 0 : CBVH_ST_NO_FIT;
+}
+
+/* One axis of a child through the compressor unit itself: codes (with the
+ * relative offset pm removed) and child scale.  0 or a status. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static uint32_t axis_unit(const cbvh_params *p, const cbvh_bvh_node *cn, int a, int cs, uint32_t pm, uint64_t *w,
+                          int *child_scale) {
+    cbvh_axis_code code;
+    uint32_t st = cbvh_axis_compress(p, cbvh_f32_of(cn->lo[a]), cbvh_f32_of(cn->hi[a]), cs, &code);
+    int n = p->quant_bits;
+    uint32_t mask = (1u << n) - 1u;
+    *w |= (uint64_t)((code.lb_mod - pm) & mask) << (2 * a * n) | (uint64_t)((code.ub_mod - pm) & mask)
+                                                                      << (2 * a * n + n);
+    *child_scale = code.child_scale;
+    return st;
+}
+
+/* The code bits [0, 6N) of a leaf child at the parent's scales cs: its box
+ * floored directly.  0, or nonzero: the box does not fit (general path). */
+static inline int leaf_codes(const cbvh_params *p, int n, const cbvh_bvh_node *cn, const int cs[3],
+                             const uint32_t pm[3], uint64_t *w) {
+    int bad = 0;
+    uint32_t mask = (1u << n) - 1u;
+    uint64_t acc = 0;
+    for (int a = 0; a < 3; a++) {
+        int64_t k, ku;
+        if (!(cbvh_fast_floor(cbvh_f32_of(cn->lo[a]), cs[a], &k) & cbvh_fast_floor(cbvh_f32_of(cn->hi[a]), cs[a], &ku))) {
+            int unused;
+            bad |= axis_unit(p, cn, a, cs[a], pm[a], &acc, &unused) != 0;
+            continue;
+        }
+        bad |= (uint64_t)(ku - k) >= (UINT64_C(1) << n); /* cells = ku + 1 - k in 1..2^N */
+        acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm[a]) & mask) << (2 * a * n) |
+               (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm[a]) & mask) << (2 * a * n + n);
+    }
+    *w = acc;
+    return bad;
+}
+
+/* The same for an inner child from its record r (exact k, ku at its
+ * estimated scale e <= cs).  *maybe: its context may differ from its
+ * estimate (modulo: a child scale changed, exactly; relative: also a lower
+ * bound that can have moved); the caller decides with the units. */
+static inline int inner_codes(const cbvh_params *p, int n, int ms, const bu_rec *r, const cbvh_bvh_node *cn,
+                              const int cs[3], const uint32_t pm[3], int rel, uint64_t *w, int *maybe) {
+    int bad = 0, dif = 0;
+    uint32_t mask = (1u << n) - 1u;
+    uint64_t acc = 0;
+    for (int a = 0; a < 3; a++) {
+        const bu_axis *ra = &r->ax[a];
+        int d = cs[a] - ra->e, ccs;
+        if (!ra->exact || d < 0) {
+            bad |= axis_unit(p, cn, a, cs[a], pm[a], &acc, &ccs) != 0;
+            dif |= ccs != ra->cs || rel;
+            continue;
+        }
+        int64_t k = cbvh_fast_floor_shift(ra->k, d), ku = cbvh_fast_floor_shift(ra->ku, d);
+        uint64_t cells = (uint64_t)(ku + 1 - k);
+        bad |= cells - 1u >= (UINT64_C(1) << n);
+        ccs = cs[a] - n + cbvh_grid_bitlen(cells - 1u);
+        ccs = ccs < ms ? ms : ccs;
+        dif |= ccs != ra->cs;
+        /* relative: u = RD(k 2^cs) equals the estimate's RD(k_e 2^e) when
+         * k_e is a multiple of 2^d (the same value); otherwise check */
+        if (rel && d) dif |= d > 62 ? ra->k != 0 : ((uint64_t)ra->k & ((UINT64_C(1) << d) - 1u)) != 0;
+        acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm[a]) & mask) << (2 * a * n) |
+               (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm[a]) & mask) << (2 * a * n + n);
+    }
+    *w = acc;
+    *maybe = dif;
+    return bad;
+}
+
 int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_compress_opts *o, cbvh_tree *out,
                            cbvh_bu_stats *stats, char *err, size_t errlen) {
     memset(stats, 0, sizeof *stats);
@@ -159,46 +316,129 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
         cbvh_layout_free(&l);
         return -1;
     }
-    cbvh_node_ctx *ctx_stack = malloc(((size_t)l.npairs + 1) * sizeof *ctx_stack);
+    /* cbvh_tree_init has checked the parameters and that every pointer fits
+     * its field, so the fast path packs codes without the encoder's checks. */
+    const cbvh_params *p = &o->params;
+    const int nq = p->quant_bits, msc = p->min_scale, rel = o->enc == CBVH_ENC_RELATIVE;
+    const uint32_t qmask = (1u << nq) - 1u;
+    const size_t pbytes = out->pair_bytes, nbytes = pbytes / 2;
+    bu_rec *recs = malloc(((size_t)l.npairs + 1) * sizeof *recs);
     uint32_t *walk = malloc(((size_t)b->nnodes + 1) * sizeof *walk); /* node << 1 | children pushed */
     bu_state s = {o, out, stats, malloc(((size_t)l.npairs + 2) * sizeof(bt_item)), err, errlen};
-    if (!ctx_stack || !walk || !s.stack) abort();
+    if (!recs || !walk || !s.stack) abort();
     uint32_t sp = 0, ws = 0, npairs = 0, nids = 0, emitted = 0;
     int rc = 0, not_tree = 0;
-    cbvh_node_ctx est = {{{0}}};
     walk[ws++] = b->root << 1;
+    /* Leaves are emitted without a walk step of their own: a left leaf child
+     * when its parent is first visited (it is next in post-order), a right
+     * one when the parent is revisited (after the left subtree). */
+#define EMIT_LEAF(y)                                                               \
+    do {                                                                           \
+        const cbvh_bvh_node *ln_ = &b->nodes[y];                                   \
+        if ((not_tree = ++emitted > b->nnodes || ln_->count > l.nids - nids)) break; \
+        l.slot[y] = nids;                                                          \
+        cbvh_tree_put_ids(out, b, ln_, nids);                                      \
+        nids += ln_->count;                                                        \
+        if (refit_tris) box_of_leaf(b, y, refit_tris);                             \
+    } while (0)
     while (ws && rc == 0) {
         uint32_t e = walk[--ws], x = e >> 1;
         const cbvh_bvh_node *n = &b->nodes[x];
         int leaf = cbvh_bvh_is_leaf(n);
         if (!leaf && !(e & 1u)) {
             if ((not_tree = ws + 3 > b->nnodes + 1)) break; /* a node reached twice */
+            uint32_t c0 = n->child[0], c1 = n->child[1];
             walk[ws++] = e | 1u;
-            walk[ws++] = n->child[1] << 1;
-            walk[ws++] = n->child[0] << 1;
+            const cbvh_bvh_node *n1 = &b->nodes[c1];
+            if (!cbvh_bvh_is_leaf(n1)) {
+                walk[ws++] = c1 << 1;
+#if defined(__GNUC__) /* needed once the left subtree is done */
+                __builtin_prefetch(&b->nodes[n1->child[0]]);
+                __builtin_prefetch(&b->nodes[n1->child[1]]);
+#endif
+            }
+            if (!cbvh_bvh_is_leaf(&b->nodes[c0]))
+                walk[ws++] = c0 << 1;
+            else
+                EMIT_LEAF(c0);
+            if (not_tree) break;
             continue;
         }
-        if ((not_tree = ++emitted > b->nnodes)) break;
-        if (leaf) {
-            if ((not_tree = n->count > l.nids - nids)) break;
-            l.slot[x] = nids;
-            cbvh_tree_put_ids(out, b, n, nids);
-            nids += n->count;
-            if (refit_tris) box_of_leaf(b, x, refit_tris);
-            if (x != b->root) continue; /* leaves have no pair of their own */
+        if (leaf) { /* only the root is walked as a leaf */
+            EMIT_LEAF(x);
+            if (not_tree) break;
         } else {
-            if ((not_tree = npairs >= l.npairs)) break;
+            if (cbvh_bvh_is_leaf(&b->nodes[n->child[1]])) EMIT_LEAF(n->child[1]);
+            if (not_tree) break;
+            if ((not_tree = ++emitted > b->nnodes || npairs >= l.npairs)) break;
             l.slot[x] = npairs++;
             if (refit_tris) box_of_inner(b, x);
         }
+        uint32_t pair = leaf ? out->root_pair : l.slot[x];
+        uint8_t *bytes = out->pairs + (size_t)pair * pbytes;
+
+        /* ---- fast path: an inner node whose boxes all take the integer steps */
+        if (!leaf) {
+            bu_rec rx;
+            const cbvh_bvh_node *cn[2] = {&b->nodes[n->child[0]], &b->nodes[n->child[1]]};
+            int cleaf[2] = {cbvh_bvh_is_leaf(cn[0]), cbvh_bvh_is_leaf(cn[1])};
+            /* the children's records: child 1's on top */
+            const bu_rec *cr[2] = {NULL, NULL};
+            uint32_t inner_children = (uint32_t)(!cleaf[0] + !cleaf[1]);
+            if (inner_children > sp) goto general; /* not a tree; the general path reports it */
+            if (!cleaf[1]) cr[1] = &recs[sp - 1];
+            if (!cleaf[0]) cr[0] = &recs[sp - 1 - !cleaf[1]];
+            int bad = 0;
+            for (int a = 0; a < 3; a++) bad |= est_axis(p, nq, msc, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &rx.ax[a]) != 0;
+            if (bad) goto general;
+            int cs[3];
+            uint32_t pm[3] = {0, 0, 0}; /* relative: the node's lower bound at cs */
+            for (int a = 0; a < 3; a++) {
+                cs[a] = rx.ax[a].cs;
+                int shift = rx.ax[a].e - cs[a];
+                if (rel) pm[a] = shift >= nq ? 0 : (rx.ax[a].lb_mod << shift) & qmask;
+            }
+            uint64_t w[2];
+            int maybe[2] = {0, 0};
+            for (int c = 0; c < 2; c++) /* one branch per child, not per axis */
+                bad |= cleaf[c] ? leaf_codes(p, nq, cn[c], cs, pm, &w[c])
+                                : inner_codes(p, nq, msc, cr[c], cn[c], cs, pm, rel, &w[c], &maybe[c]);
+            if (bad) goto general;
+            for (int c = 0; c < 2; c++)
+                cbvh_fast_put_node(nq, w[c], cleaf[c], l.slot[n->child[c]], bytes + (size_t)c * nbytes);
+            stats->encodes++;
+            /* A child whose context may have changed: its actual context from
+             * the compressor (as the general path), compared as specified. */
+            for (int c = 1; c >= 0; c--) {
+                if (!maybe[c]) continue;
+                cbvh_node_ctx stored, actual;
+                rec_ctx(cr[c], &stored);
+                for (int a = 0; a < 3; a++) {
+                    cbvh_axis_code code;
+                    cbvh_axis_compress(p, cbvh_f32_of(cn[c]->lo[a]), cbvh_f32_of(cn[c]->hi[a]), cs[a], &code);
+                    actual.axis[a] = cbvh_axis_child_ctx(&(cbvh_axis_ctx){rx.ax[a].e, cs[a], rx.ax[a].lb_mod, 0}, &code);
+                }
+                if (ctx_differs(o->enc, &stored, &actual) && backtrack(&s, l.slot[n->child[c]], &stored, &actual)) {
+                    rc = -1;
+                    break;
+                }
+            }
+            if (rc) break;
+            sp -= inner_children;
+            recs[sp++] = rx;
+            continue;
+        }
+
+    general:;
+        /* ---- general path: the units, as specified */
+        cbvh_node_ctx est = {{{0}}};
         uint32_t st = 0;
         for (int a = 0; a < 3; a++)
-            st |= cbvh_axis_root_ctx(&o->params, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &est.axis[a]);
+            st |= cbvh_axis_root_ctx(p, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &est.axis[a]);
         cbvh_child_in in[2];
         cbvh_child_out co[2];
         cbvh_pair_inputs(b, &l, x, in);
-        uint32_t pair = leaf ? out->root_pair : l.slot[x];
-        st |= cbvh_nodepair_encode(&o->params, o->enc, &est, in, out->pairs + (size_t)pair * out->pair_bytes, co);
+        st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
         if (st & ENC_FAIL) {
             snprintf(err, errlen, "cbvh bottom-up: pair %u rejected by the encoder (status 0x%x)", pair, st);
             rc = -1;
@@ -207,14 +447,18 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
         stats->encodes++;
         for (int c = 1; c >= 0 && !leaf; c--) {
             if (in[c].leaf) continue;
-            cbvh_node_ctx stored = ctx_stack[--sp], actual;
+            cbvh_node_ctx stored, actual;
+            rec_ctx(&recs[--sp], &stored);
             cbvh_child_ctx3(&est, &co[c], &actual);
             if (ctx_differs(o->enc, &stored, &actual) && backtrack(&s, in[c].ptr, &stored, &actual)) {
                 rc = -1;
                 break;
             }
         }
-        ctx_stack[sp++] = est;
+        bu_rec *r = &recs[sp++];
+        rec_of_ctx(&est, r);
+        for (int a = 0; a < 3 && !leaf; a++) /* exact coordinates for the parent's fast path */
+            r->ax[a].exact = floor2(cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), r->ax[a].e, &r->ax[a].k, &r->ax[a].ku);
     }
     if (rc == 0 && (not_tree || nids != l.nids || (!cbvh_bvh_is_leaf(&b->nodes[b->root]) && npairs != l.npairs))) {
         snprintf(err, errlen, "cbvh bottom-up: the BVH is not a tree (a node is reached twice or never)");
@@ -223,10 +467,13 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
     if (rc == 0) {
         /* The root's estimated context is the root context by definition. */
         const cbvh_bvh_node *r = &b->nodes[b->root];
-        for (int a = 0; a < 3; a++) out->root_lo[a] = cbvh_f32_of(r->lo[a]), out->root_hi[a] = cbvh_f32_of(r->hi[a]);
-        out->root_ctx = est;
+        for (int a = 0; a < 3; a++) {
+            out->root_lo[a] = cbvh_f32_of(r->lo[a]), out->root_hi[a] = cbvh_f32_of(r->hi[a]);
+            cbvh_axis_root_ctx(p, out->root_lo[a], out->root_hi[a], &out->root_ctx.axis[a]);
+        }
     }
-    free(ctx_stack);
+#undef EMIT_LEAF
+    free(recs);
     free(walk);
     free(s.stack);
     cbvh_layout_free(&l);

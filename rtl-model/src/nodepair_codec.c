@@ -12,6 +12,7 @@
 
 #include "cbvh/datapath.h"
 #include "grid.h"
+#include "unit_fast.h"
 
 int cbvh_node_bits(int n) { return n <= 6 ? 64 : 96; }
 size_t cbvh_nodepair_bytes(int n) { return (size_t)cbvh_node_bits(n) / 4u; }
@@ -32,21 +33,16 @@ typedef struct {
     uint64_t w[2];
 } node_bits;
 
-static node_bits load_node(const uint8_t *b, int nbytes) {
-    node_bits v = {{0, 0}};
-    for (int i = 0; i < nbytes; i++) v.w[i >> 3] |= (uint64_t)b[i] << (8 * (i & 7));
+static uint64_t load_le(const uint8_t *b, int nbytes) {
+    uint64_t v = 0;
+    for (int i = 0; i < nbytes; i++) v |= (uint64_t)b[i] << (8 * i);
     return v;
 }
 
-static void store_node(const node_bits *v, uint8_t *b, int nbytes) {
-    for (int i = 0; i < nbytes; i++) b[i] = (uint8_t)(v->w[i >> 3] >> (8 * (i & 7)));
-}
-
-/* The low `width` (1..32) bits of v into bits [pos, pos + width) (zero before). */
-static void put_bits(node_bits *n, int pos, int width, uint32_t v) {
-    uint64_t x = (uint64_t)v & ((UINT64_C(1) << width) - 1);
-    n->w[pos >> 6] |= x << (pos & 63);
-    if ((pos & 63) + width > 64) n->w[(pos >> 6) + 1] |= x >> (64 - (pos & 63));
+/* A node (8 or 12 bytes). */
+static node_bits load_node(const uint8_t *b, int nbytes) {
+    node_bits v = {{load_le(b, 8), nbytes > 8 ? load_le(b + 8, nbytes - 8) : 0}};
+    return v;
 }
 
 static uint32_t get_bits(const node_bits *n, int pos, int width) {
@@ -63,38 +59,36 @@ uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbv
     if (st) return st;
     size_t nb = cbvh_nodepair_bytes(n);
     int w = cbvh_node_bits(n), pb = cbvh_node_ptr_bits(n);
-    memset(bytes, 0, nb);
     uint32_t ones = ptr_all_ones(n);
     /* The context is checked as the decoder checks it, so both directions
      * reject the same contexts (relative codes depend on parent_scale - scale). */
     for (int a = 0; a < 3; a++) st |= cbvh_axis_ctx_check(p, &ctx->axis[a]);
-    if (st) return st; /* bytes and outputs are zero */
+    if (st) {
+        memset(bytes, 0, nb); /* bytes and outputs are zero */
+        return st;
+    }
     for (int c = 0; c < 2; c++) {
         uint8_t *bytes_c = bytes + (size_t)c * (size_t)w / 8u;
-        node_bits nb_c = {{0, 0}}, *node = &nb_c;
         cbvh_child_out *o = &out[c];
         if (child[c].empty) {
             o->empty = o->leaf = 1;
             o->ptr = ones;
-            put_bits(node, 6 * n, 1, 1);
-            put_bits(node, 6 * n + 1, pb, ones);
-            store_node(node, bytes_c, w / 8);
+            cbvh_fast_put_node(n, 0, 1, ones, bytes_c); /* writes the whole node */
             continue;
         }
         if (child[c].leaf ? child[c].ptr >= ones : (pb < 32 && child[c].ptr > ones)) st |= CBVH_ST_BAD_FORMAT;
         o->leaf = child[c].leaf != 0;
         o->ptr = child[c].ptr;
+        uint64_t codes = 0;
         for (int a = 0; a < 3; a++) {
             const cbvh_axis_ctx *ac = &ctx->axis[a];
             st |= cbvh_axis_compress(p, child[c].lo[a], child[c].hi[a], ac->scale, &o->axis[a]);
             uint32_t lc, uc;
             cbvh_axis_store_codes(p, enc, ac, &o->axis[a], &lc, &uc);
-            put_bits(node, 2 * a * n, n, lc);
-            put_bits(node, 2 * a * n + n, n, uc);
+            codes |= (uint64_t)lc << (2 * a * n) | (uint64_t)uc << (2 * a * n + n);
         }
-        put_bits(node, 6 * n, 1, (uint32_t)o->leaf);
-        put_bits(node, 6 * n + 1, pb, o->ptr);
-        store_node(node, bytes_c, w / 8);
+        /* a pointer wider than its field is BAD_FORMAT: the pair is zeroed below */
+        cbvh_fast_put_node(n, codes, o->leaf, o->ptr & ones, bytes_c);
     }
     if (st & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT)) {
         memset(bytes, 0, nb);

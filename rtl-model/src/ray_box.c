@@ -67,6 +67,8 @@ static uint32_t check_common(const cbvh_ray *ray, int M) {
     return st;
 }
 
+uint32_t cbvh_rb_ray_status(const cbvh_ray *ray, int M) { return check_common(ray, M); }
+
 uint32_t cbvh_ray_box_exact_only(const cbvh_ray *ray, int M, const cbvh_grid_axis axis[3], cbvh_box_result *out) {
     memset(out, 0, sizeof *out);
     uint32_t st = check_common(ray, M);

@@ -32,6 +32,11 @@ typedef struct {
 
 void cbvh_rb_prepare(const cbvh_ray *ray, cbvh_rb_ray *p);
 
+/* The status bits the box unit gives for the ray and M alone (BAD_PARAM,
+ * NAN_INF, ZERO_DIR): the unit returns at least these for every box, and no
+ * other bit for a valid box.  The traversals' ray check. */
+uint32_t cbvh_rb_ray_status(const cbvh_ray *ray, int M);
+
 /* cbvh_ray_box / cbvh_ray_box_float for a prepared ray with tmax replaced by
  * `tmax` (the traversal's culling bound); same outputs and status bit for bit. */
 uint32_t cbvh_ray_box_prep(const cbvh_rb_ray *p, cbvh_f32 tmax, int M, const cbvh_grid_axis axis[3],

@@ -14,6 +14,7 @@
  * this against the binary search over [min_scale, 126] it replaces. */
 #include "cbvh/datapath.h"
 #include "grid.h"
+#include "unit_fast.h"
 
 /* Does [lb, ub] span at most 2^N cells on grid 2^e? */
 static inline int fits(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e) {
@@ -24,9 +25,8 @@ static inline int fits(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e) {
     return ku + 1 - kl <= (INT64_C(1) << p->quant_bits);
 }
 
-/* Widest alignment kept exactly: significands (< 2^24) shifted by up to 38
- * bits stay below 2^62, so the sum of two stays below 2^63. */
-#define WIDTH_SPAN 38
+/* Widest alignment kept exactly (unit_fast.h). */
+#define WIDTH_SPAN CBVH_WIDTH_SPAN
 
 /* Every input: parameter and input checks, zeros, subnormals, bounds far
  * apart.  Kept out of line so the fast path below stays small. */
@@ -86,30 +86,9 @@ static uint32_t estimate_general(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub,
     return 0;
 }
 
-/* Fast path: valid parameters, both bounds normal, lb < ub, exponents at
- * most 38 apart: the near case of estimate_general without its checks. */
+/* The fast path lives in unit_fast.h (the bottom-up compressor inlines it);
+ * every input it does not take goes to estimate_general. */
 uint32_t cbvh_scale_estimate(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int *scale) {
-    int n = p->quant_bits, ms = p->min_scale;
-    uint32_t el = (lb >> 23) & 0xFFu, eu = (ub >> 23) & 0xFFu;
-    int dx = (int)el - (int)eu;
-    if ((uint32_t)(n - CBVH_N_MIN) > (uint32_t)(CBVH_N_MAX - CBVH_N_MIN) || ms < CBVH_SCALE_FLOOR ||
-        ms > CBVH_SCALE_CEIL || el - 1u > 253u || eu - 1u > 253u || dx < -WIDTH_SPAN || dx > WIDTH_SPAN)
-        return estimate_general(p, lb, ub, scale);
-    int64_t ml = (int64_t)((lb & CBVH_F32_FRAC) | 0x800000u), mu = (int64_t)((ub & CBVH_F32_FRAC) | 0x800000u);
-    int xlo = (int)(dx < 0 ? el : eu) - 150; /* the lower exponent */
-    int64_t vl = (lb & CBVH_F32_SIGN ? -ml : ml) * (INT64_C(1) << (dx > 0 ? dx : 0));
-    int64_t vu = (ub & CBVH_F32_SIGN ? -mu : mu) * (INT64_C(1) << (dx < 0 ? -dx : 0));
-    if (vl >= vu) return estimate_general(p, lb, ub, scale); /* inverted or a point */
-    int e0 = cbvh_grid_bitlen((uint64_t)(vu - vl)) + xlo - n;
-    if (e0 < ms) e0 = ms;
-    /* cells(e0) = floor(vu / 2^d) + 1 - floor(vl / 2^d), d = e0 - xlo.  With
-     * |v| < 2^62, floor(v / 2^d) = ((v + 2^62) >> d) - 2^(62 - d) for
-     * d <= 62 (the offsets cancel in the difference), and every d >= 62 gives
-     * the same floors (-1 or 0).  d <= 0: always fits (see above). */
-    int d = e0 - xlo;
-    if (d > 62) d = 62;
-    uint64_t ou = (uint64_t)(vu + (INT64_C(1) << 62)), ol = (uint64_t)(vl + (INT64_C(1) << 62));
-    int fit = d <= 0 || (ou >> d) - (ol >> d) + 1u <= (UINT64_C(1) << n);
-    *scale = fit ? e0 : e0 + 1;
-    return 0;
+    if (cbvh_scale_estimate_fast(p, lb, ub, scale)) return 0;
+    return estimate_general(p, lb, ub, scale);
 }

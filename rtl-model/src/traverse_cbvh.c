@@ -2,14 +2,22 @@
  * the node-pair codec (unit 5) under the node's context, and each child box is
  * tested with the ray-box unit on the decoded grid (unit 6): planes
  * u + r 2^e and u + s 2^e with u, e from the node's context and r, s the
- * child's relative coordinates. */
+ * child's relative coordinates.
+ *
+ * Fast paths (docs/traversal.md §9), each proven to give the units' outputs
+ * and falling back to the units otherwise: the node-pair decode of
+ * decode_fast.h, the box unit's binary64 filter (ray_box_f64.h) on planes
+ * that are exact in binary64, and the child context's bound clb = RD(u + r 2^e)
+ * rounded directly from that exact plane. */
+#include "decode_fast.h"
+#include "ray_box_f64.h"
 #include "traverse_common.h"
 
 typedef struct {
     int leaf;
     uint32_t ptr;
     cbvh_node_ctx ctx; /* inner: the child's own context */
-    cbvh_f32 t_near;
+    double t_near;     /* binary64: its order is the unit's key order */
 } entry;
 
 /* Relative coordinates of a decoded child (r in [0, 2^N), s in [1, 2^N]). */
@@ -19,76 +27,165 @@ static void rel_coords(const cbvh_params *p, const cbvh_axis_ctx *ctx, const cbv
     if (*s == 0) *s = 1u << p->quant_bits;
 }
 
+/* The ray prepared for the unit's integer fast path, on the first fallback. */
+static const cbvh_rb_ray *prep(trav_state *ts) {
+    if (!ts->prep.ray) cbvh_rb_prepare(ts->ray, &ts->prep);
+    return &ts->prep;
+}
+
 int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
                     cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     trav_state ts;
     memset(&ts, 0, sizeof ts);
     memset(hit, 0, sizeof *hit);
-    if (!trav_ray_ok(&ts, ray, mant_bits)) return -1;
+    /* the ray check of trav_ray_ok, without preparing the ray */
+    if (cbvh_rb_ray_status(ray, mant_bits)) return -1;
     ts.ray = ray;
     ts.tris = tris;
     ts.mode = mode;
     ts.M = mant_bits;
     ts.ids_base = trav_align((uint64_t)t->npairs * t->pair_bytes);
     ts.tris_base = trav_align(ts.ids_base + (uint64_t)t->nids * 4u);
+    cbvh_rbf_ray fp;
+    cbvh_rbf_prepare(ray, mant_bits, &fp);
+    const cbvh_params *prm = &t->params;
+    int fast_codec = t->pair_bytes == 16; /* 64-bit nodes (N <= 6) */
 
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;
+    uint32_t max_stack = 0;
+    cbvh_f32 cull = trav_box_tmax(&ts);
+    double cull_d = cbvh_rbf_f32(cull);
     cbvh_box_result r;
     ts.s.box_tests++;
-    if (cbvh_ray_box_float_prep(&ts.prep, trav_box_tmax(&ts), mant_bits, t->root_lo, t->root_hi, &r) == 0 && r.hit) {
+    double rlo[3], rhi[3], rtn;
+    int rhit;
+    for (int a = 0; a < 3; a++) {
+        rlo[a] = cbvh_rbf_f32(t->root_lo[a]);
+        rhi[a] = cbvh_rbf_f32(t->root_hi[a]);
+    }
+    if (!cbvh_rbf_box(&fp, cull_d, rlo, rhi, &rhit, &rtn)) {
+        rhit = cbvh_ray_box_float_prep(prep(&ts), cull, mant_bits, t->root_lo, t->root_hi, &r) == 0 && r.hit;
+        rtn = cbvh_rbf_f32(r.t_near);
+    }
+    if (rhit) {
         stack[0].leaf = 0;
         stack[0].ptr = t->root_pair;
         stack[0].ctx = t->root_ctx;
-        stack[0].t_near = r.t_near;
+        stack[0].t_near = rtn;
         sp = 1;
-        ts.s.max_stack = 1;
+        max_stack = 1;
     }
-    while (sp > 0 && !ts.done) {
-        entry e = stack[--sp];
-        if (cbvh_f32_key(e.t_near) > cbvh_f32_key(trav_box_tmax(&ts))) continue;
-        if (e.leaf) {
-            for (uint32_t i = e.ptr; i < t->nids && !ts.done; i++) {
+    while (sp > 0) {
+        entry *e = &stack[--sp];
+        if (e->t_near > cull_d) continue;
+        if (e->leaf) {
+            /* start the leaf's triangle loads together (memory latency) */
+            for (uint32_t i = e->ptr; i < t->nids; i++) {
+                __builtin_prefetch(&tris[t->ids[i] & ~CBVH_ID_LAST]);
+                if (t->ids[i] & CBVH_ID_LAST) break;
+            }
+            for (uint32_t i = e->ptr; i < t->nids && !ts.done; i++) {
                 trav_fetch(&ts, ts.ids_base + (uint64_t)i * 4u, 4u);
                 trav_triangle(&ts, t->ids[i] & ~CBVH_ID_LAST);
                 if (t->ids[i] & CBVH_ID_LAST) break;
             }
+            if (ts.done) break;
+            cull = trav_box_tmax(&ts);
+            cull_d = cbvh_rbf_f32(cull);
             continue;
         }
-        if (e.ptr >= t->npairs) return -1;
+        if (e->ptr >= t->npairs) return -1;
         ts.s.nodes++;
-        trav_fetch(&ts, (uint64_t)e.ptr * t->pair_bytes, t->pair_bytes);
-        cbvh_child_out ch[2];
-        if (cbvh_nodepair_decode(&t->params, t->enc, &e.ctx, t->pairs + (size_t)e.ptr * t->pair_bytes, ch) &
-            CBVH_ST_REJECT)
-            return -1;
-        cbvh_box_result cr[2];
+        trav_fetch(&ts, (uint64_t)e->ptr * t->pair_bytes, t->pair_bytes);
+        const uint8_t *pair = t->pairs + (size_t)e->ptr * t->pair_bytes;
+        cbvh_node_ctx ctx = e->ctx; /* e's slot is reused by the pushes below */
+        double tn[2];
         int h[2] = {0, 0};
-        cbvh_f32 cull_tmax = trav_box_tmax(&ts);
-        for (int c = 0; c < 2; c++) {
-            if (ch[c].empty) continue;
-            cbvh_grid_axis g[3];
-            for (int a = 0; a < 3; a++) {
-                g[a].u = e.ctx.axis[a].clb;
-                g[a].e = e.ctx.axis[a].scale;
-                rel_coords(&t->params, &e.ctx.axis[a], &ch[c].axis[a], &g[a].r, &g[a].s);
+        cbvh_fast_child fc[2];
+        if (fast_codec && cbvh_fast_pair_decode(prm, t->enc, &ctx, pair, fc)) {
+            cbvh_rbf_axis ax[3];
+            for (int a = 0; a < 3; a++) ax[a] = cbvh_rbf_axis_prep(ctx.axis[a].clb, ctx.axis[a].scale);
+            int exact = ax[0].exact & ax[1].exact & ax[2].exact;
+            double lo[3][2], hi[3][2], tf[2] = {0, 0};
+            int hf[2] = {0, 0};
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 2; c++) { /* an empty slot gets a dummy box, its lane is ignored */
+                    lo[a][c] = ax[a].u + (double)(fc[c].empty ? 0 : fc[c].r[a]) * ax[a].step;
+                    hi[a][c] = ax[a].u + (double)(fc[c].empty ? 1 : fc[c].s[a]) * ax[a].step;
+                }
+            int dec = exact ? cbvh_rbf_box2(&fp, cull_d, lo, hi, hf, tf) : 0;
+            for (int c = 0; c < 2; c++) {
+                if (fc[c].empty) continue;
+                ts.s.box_tests++;
+                if (dec >> c & 1) {
+                    h[c] = hf[c];
+                    tn[c] = tf[c];
+                    continue;
+                }
+                cbvh_grid_axis g[3];
+                for (int a = 0; a < 3; a++) {
+                    g[a].u = ctx.axis[a].clb;
+                    g[a].e = ctx.axis[a].scale;
+                    g[a].r = fc[c].r[a];
+                    g[a].s = fc[c].s[a];
+                }
+                h[c] = cbvh_ray_box_prep(prep(&ts), cull, mant_bits, g, &r) == 0 && r.hit;
+                tn[c] = cbvh_rbf_f32(r.t_near);
             }
-            ts.s.box_tests++;
-            h[c] = cbvh_ray_box_prep(&ts.prep, cull_tmax, mant_bits, g, &cr[c]) == 0 && cr[c].hit;
+            if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
+            int first = h[0] && h[1] && tn[1] < tn[0];
+            for (int k = 1; k >= 0; k--) {
+                int c = k ? 1 - first : first;
+                if (!h[c]) continue;
+                entry *ne = &stack[sp++];
+                ne->leaf = fc[c].leaf;
+                ne->ptr = fc[c].ptr;
+                ne->t_near = tn[c];
+                if (ne->leaf) continue; /* a leaf entry's context is never read */
+                for (int a = 0; a < 3; a++) {
+                    cbvh_fast_child_ctx(prm, t->enc, &ctx.axis[a], &fc[c], a, ax[a].exact ? &lo[a][c] : NULL,
+                                        &ne->ctx.axis[a]);
+                }
+            }
+        } else {
+            cbvh_child_out ch[2];
+            if (cbvh_nodepair_decode(prm, t->enc, &ctx, pair, ch) & CBVH_ST_REJECT) return -1;
+            for (int c = 0; c < 2; c++) {
+                if (ch[c].empty) continue;
+                cbvh_grid_axis g[3];
+                for (int a = 0; a < 3; a++) {
+                    g[a].u = ctx.axis[a].clb;
+                    g[a].e = ctx.axis[a].scale;
+                    rel_coords(prm, &ctx.axis[a], &ch[c].axis[a], &g[a].r, &g[a].s);
+                }
+                ts.s.box_tests++;
+                h[c] = cbvh_ray_box_prep(prep(&ts), cull, mant_bits, g, &r) == 0 && r.hit;
+                tn[c] = cbvh_rbf_f32(r.t_near);
+            }
+            if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
+            int first = h[0] && h[1] && tn[1] < tn[0];
+            for (int k = 1; k >= 0; k--) {
+                int c = k ? 1 - first : first;
+                if (!h[c]) continue;
+                entry *ne = &stack[sp++];
+                ne->leaf = ch[c].leaf;
+                ne->ptr = ch[c].ptr;
+                for (int a = 0; a < 3; a++) ne->ctx.axis[a] = cbvh_axis_child_ctx(&ctx.axis[a], &ch[c].axis[a]);
+                ne->t_near = tn[c];
+            }
         }
-        int first = (h[0] && h[1] && cbvh_f32_key(cr[1].t_near) < cbvh_f32_key(cr[0].t_near)) ? 1 : 0;
-        for (int k = 1; k >= 0; k--) {
-            int c = k ? 1 - first : first;
-            if (!h[c]) continue;
-            if (sp == CBVH_TRAV_STACK) return -1;
-            entry *n = &stack[sp++];
-            n->leaf = ch[c].leaf;
-            n->ptr = ch[c].ptr;
-            for (int a = 0; a < 3; a++) n->ctx.axis[a] = cbvh_axis_child_ctx(&e.ctx.axis[a], &ch[c].axis[a]);
-            n->t_near = cr[c].t_near;
-            if ((uint32_t)sp > ts.s.max_stack) ts.s.max_stack = (uint32_t)sp;
+        if ((uint32_t)sp > max_stack) max_stack = (uint32_t)sp;
+        /* what the pushed children read next: their pair or their IDs */
+        for (int k = sp - h[0] - h[1]; k < sp; k++) {
+            if (stack[k].leaf) {
+                if (stack[k].ptr < t->nids) __builtin_prefetch(&t->ids[stack[k].ptr]);
+            } else if (stack[k].ptr < t->npairs) {
+                __builtin_prefetch(t->pairs + (size_t)stack[k].ptr * t->pair_bytes);
+            }
         }
     }
+    ts.s.max_stack = max_stack;
     trav_finish(&ts, hit, st);
     return 0;
 }

@@ -278,6 +278,25 @@ static void ray_tri_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32
     out[4] = st;
 }
 
+/* ---- ray_sphere (docs/traversal.md §10) ---- */
+static const char *const sphere_names[4] = {"cx", "cy", "cz", "r"};
+static void ray_sphere_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    for (int i = 0; i < 8; i++) add(l->in, &l->n_in, ray_names[i], F32);
+    for (int i = 0; i < 4; i++) add(l->in, &l->n_in, sphere_names[i], F32);
+    add(l->out, &l->n_out, "hit", 1);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void ray_sphere_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    (void)cfg;
+    cbvh_ray r = ray_words(in);
+    int hit;
+    uint32_t st = cbvh_ray_sphere(&r, in + 8, in[11], &hit);
+    out[0] = (uint32_t)hit;
+    out[1] = st;
+}
+
 /* ---- qbvh_stack (docs/qbvh.md §2) ---- */
 static void qstack_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
     (void)cfg;
@@ -334,10 +353,11 @@ static const cbvh_unit unit_decode_pair = {"nodepair_decode", 5, 1, decode_pair_
 static const cbvh_unit unit_ray_box = {"ray_box", 6, 0, ray_box_layout, ray_box_eval};
 static const cbvh_unit unit_ray_triangle = {"ray_triangle", 7, 0, ray_tri_layout, ray_tri_eval};
 static const cbvh_unit unit_qbvh_stack = {"qbvh_stack", 8, 0, qstack_layout, qstack_eval};
+static const cbvh_unit unit_ray_sphere = {"ray_sphere", 9, 0, ray_sphere_layout, ray_sphere_eval};
 
 const cbvh_unit *const cbvh_units[] = {&unit_estimate, &unit_compress, &unit_decode, &unit_encode_pair,
                                        &unit_decode_pair, &unit_ray_box, &unit_ray_triangle,
-                                       &unit_qbvh_stack};
+                                       &unit_qbvh_stack, &unit_ray_sphere};
 const int cbvh_unit_count = (int)(sizeof cbvh_units / sizeof cbvh_units[0]);
 
 const cbvh_unit *cbvh_unit_find(const char *name) {

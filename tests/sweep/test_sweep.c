@@ -176,20 +176,21 @@ static void test_corrupted_anyhit_fails(void **state) {
  * BVH, its own heat-map data and stack-unit activity; absent by default. */
 static void qbvh_run(int corrupt, uint64_t ray, cbvh_sweep_result *out) {
     cbvh_sweep_opts o = {.bits_lo = 6, .bits_hi = 6, .mant = {24}, .nmant = 1, .min_scale = {-30},
-                         .nmin_scale = 1, .qbvh = 1, .corrupt_setting = corrupt, .corrupt_ray = ray};
+                         .nmin_scale = 1, .nextra = 1, .corrupt_setting = corrupt, .corrupt_ray = ray};
+    o.extra[0] = (cbvh_sweep_format){.format = CBVH_FORMAT_QBVH, .name = "qbvh"};
     char err[256];
     assert_int_equal(cbvh_sweep_run(&scene, &o, out, err, sizeof err), 0);
     assert_int_equal(out->nrows, 1);
-    assert_true(out->have_qbvh);
+    assert_int_equal(out->nextra, 1);
     assert_true(out->rows[0].same);
 }
 
 static void test_qbvh_row(void **state) {
     (void)state;
-    assert_false(res.have_qbvh);
+    assert_int_equal(res.nextra, 0);
     cbvh_sweep_result r;
     qbvh_run(-1, 0, &r);
-    const cbvh_sweep_run_t *q = &r.qbvh;
+    const cbvh_sweep_run_t *q = &r.extra[0];
     size_t npx = (size_t)r.width * (size_t)r.height;
     assert_true(q->same);
     assert_true(r.all_same);
@@ -215,10 +216,10 @@ static void test_qbvh_corrupted_fails(void **state) {
     uint64_t first = first_hit_ray();
     cbvh_sweep_result r;
     qbvh_run(1, first, &r); /* setting index 1 = the row after the CBVH settings: the QBVH */
-    assert_false(r.qbvh.same);
+    assert_false(r.extra[0].same);
     assert_false(r.all_same);
-    assert_int_equal(r.qbvh.bad_ray, first);
-    assert_non_null(strstr(r.qbvh.why, "t=0x"));
+    assert_int_equal(r.extra[0].bad_ray, first);
+    assert_non_null(strstr(r.extra[0].why, "t=0x"));
     cbvh_sweep_free(&r);
 }
 

@@ -36,7 +36,7 @@ static void load(const char *json, cbvh_scene_desc *d) {
 }
 
 static cbvh_fx_opts opts(cbvh_accel_format f) {
-    cbvh_fx_opts o = {f, {6, CBVH_MIN_SCALE_DEFAULT}, 24, 0, NULL, NULL, NULL};
+    cbvh_fx_opts o = {.format = f, .params = {6, CBVH_MIN_SCALE_DEFAULT}, .mant = 24};
     return o;
 }
 
@@ -358,6 +358,133 @@ static void qbvh_animated(void **state) {
     cbvh_scene_desc_free(&d);
 }
 
+/* ---- traversal lists (docs/tlist.md) ----------------------------------------
+ * Every effect, every list option (1/2/6/8 lists, both orders, culling,
+ * heads), two-sided and one-sided: the lists trace the float BVH's rays and
+ * return its hits ray by ray; only the sphere and triangle units run. */
+static void run_recorded_o(const cbvh_scene_desc *d, cbvh_fx_opts *o, recorder *c, cbvh_fx_result *r) {
+    memset(c, 0, sizeof *c);
+    c->w.d = d;
+    o->on_ray = record;
+    o->ctx = c;
+    run(d, o, r);
+    assert_int_equal(c->w.bad, 0);
+}
+
+static void tlist_all_effects(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load(all_fx_scene, &d);
+    static const char *specs[] = {"tlist:1",        "tlist:2:latest",     "tlist:6",           "tlist:8:latest",
+                                  "tlist:6:heads",  "tlist:6:cull",       "tlist:8:cull:heads", "tlist:1:latest:heads",
+                                  "tlist:2:cull:heads"};
+    for (int one_sided = 0; one_sided < 2; one_sided++) {
+        static cbvh_fx_result rf, rl;
+        recorder cf, cl;
+        cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
+        o.one_sided = one_sided;
+        run_recorded_o(&d, &o, &cf, &rf);
+        for (size_t k = 0; k < sizeof specs / sizeof specs[0]; k++) {
+            char err[256];
+            o = opts(CBVH_FORMAT_TLIST);
+            o.one_sided = one_sided;
+            assert_int_equal(cbvh_tlist_opts_parse(specs[k], &o.tlist, err, sizeof err), 0);
+            if (o.tlist.p.cull_back && !one_sided) {
+                cbvh_fx_result bad;
+                assert_int_equal(cbvh_fx_run(&d, &o, &bad, err, sizeof err), -1);
+                assert_non_null(strstr(err, "--one-sided"));
+                continue;
+            }
+            run_recorded_o(&d, &o, &cl, &rl);
+            if (cl.n != cf.n || memcmp(cl.rec, cf.rec, cf.n * sizeof *cf.rec))
+                fprintf(stderr, "%s (one-sided %d) differs from the float BVH\n", specs[k], one_sided);
+            assert_int_equal(cl.n, cf.n);
+            assert_memory_equal(cl.rec, cf.rec, cf.n * sizeof *cf.rec);
+            assert_int_equal(rl.hit_digest, rf.hit_digest);
+            cbvh_fx_stats t = cbvh_fx_total(&rl);
+            assert_true(rl.units.ray_sphere > 0);
+            assert_int_equal(rl.units.ray_sphere, t.st.box_tests);
+            assert_int_equal(rl.units.ray_triangle, t.st.tri_tests);
+            assert_int_equal(rl.units.ray_box + rl.units.compressor + rl.units.decoder + rl.units.refit +
+                                 rl.units.qbvh_stack,
+                             0);
+            assert_int_equal(t.st.max_stack, 0); /* stackless */
+            assert_true(rl.node_bytes > 0);
+            free(cl.rec);
+        }
+        assert_int_equal(rf.units.ray_sphere, 0);
+        free(cf.rec);
+    }
+    cbvh_scene_desc_free(&d);
+}
+
+/* Heads only skip work: the same hits with fewer sphere tests in total. */
+static void tlist_heads_save_work(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load(all_fx_scene, &d);
+    cbvh_fx_result r[2];
+    for (int h = 0; h < 2; h++) {
+        cbvh_fx_opts o = opts(CBVH_FORMAT_TLIST);
+        char err[256];
+        assert_int_equal(cbvh_tlist_opts_parse(h ? "tlist:6:heads" : "tlist:6", &o.tlist, err, sizeof err), 0);
+        run(&d, &o, &r[h]);
+    }
+    assert_int_equal(r[1].hit_digest, r[0].hit_digest);
+    cbvh_fx_stats a = cbvh_fx_total(&r[0]), b = cbvh_fx_total(&r[1]);
+    assert_true(b.st.box_tests < a.st.box_tests);
+    assert_true(r[1].fx[CBVH_FX_PRIMARY].st.box_tests < r[0].fx[CBVH_FX_PRIMARY].st.box_tests); /* cell heads */
+    assert_true(r[1].fx[CBVH_FX_DIFFUSE_BOUNCE].st.box_tests < r[0].fx[CBVH_FX_DIFFUSE_BOUNCE].st.box_tests); /* polygon */
+    assert_true(r[1].node_bytes > r[0].node_bytes); /* the per-polygon heads are stored */
+    cbvh_scene_desc_free(&d);
+}
+
+/* Animated: the lists are rebuilt every frame (lists are not updatable:
+ * culling and heads depend on the moved triangles); hits stay the float BVH's. */
+static void tlist_animated(void **state) {
+    (void)state;
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA ", \"lights\": [{\"type\": \"point\", \"position\": [8, 16, 10]}],"
+         " \"effects\": [\"primary\", \"hard_shadows\"],"
+         "\"animation\": {\"type\": \"twist\", \"frames\": 3, \"amount\": 0.8}}",
+         &d);
+    static cbvh_fx_result r[2];
+    recorder c[2];
+    cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
+    o.one_sided = 1;
+    run_recorded_o(&d, &o, &c[0], &r[0]);
+    o = opts(CBVH_FORMAT_TLIST);
+    o.one_sided = 1;
+    char err[256];
+    assert_int_equal(cbvh_tlist_opts_parse("tlist:6:cull:heads", &o.tlist, err, sizeof err), 0);
+    run_recorded_o(&d, &o, &c[1], &r[1]);
+    assert_int_equal(r[1].refits, 2);
+    assert_true(r[1].units.refit > 0);
+    assert_int_equal(c[1].n, c[0].n);
+    assert_memory_equal(c[1].rec, c[0].rec, c[0].n * sizeof *c[0].rec);
+    free(c[0].rec);
+    free(c[1].rec);
+    cbvh_scene_desc_free(&d);
+}
+
+/* The option parser: defaults, canonical names, one-line errors. */
+static void tlist_options(void **state) {
+    (void)state;
+    cbvh_tlist_opts t;
+    char err[256], name[64];
+    assert_int_equal(cbvh_tlist_opts_parse("tlist", &t, err, sizeof err), 0);
+    cbvh_tlist_opts_name(&t, name, sizeof name);
+    assert_string_equal(name, "tlist:6:earliest");
+    assert_int_equal(cbvh_tlist_opts_parse("tlist:heads:8:cull:latest", &t, err, sizeof err), 0);
+    cbvh_tlist_opts_name(&t, name, sizeof name);
+    assert_string_equal(name, "tlist:8:latest:cull:heads");
+    assert_true(t.poly_heads && t.cell_heads && t.p.cull_back && t.p.nlists == 8 && t.p.order == CBVH_TLIST_LATEST_LAST);
+    assert_int_equal(cbvh_tlist_opts_parse("tlist:4", &t, err, sizeof err), -1);
+    assert_non_null(strstr(err, "unknown tlist option '4'"));
+    assert_int_equal(cbvh_tlist_opts_parse("tlistx", &t, err, sizeof err), -1);
+    assert_int_equal(cbvh_tlist_opts_parse("tlist:", &t, err, sizeof err), -1);
+}
+
 /* Cameras: fisheye leaves the corners without rays; thin lens shoots spp
  * rays per pixel from different lens points. */
 static void cameras(void **state) {
@@ -511,7 +638,8 @@ int main(void) {
         cmocka_unit_test(primary_only), cmocka_unit_test(all_effects), cmocka_unit_test(no_mirror_material),
         cmocka_unit_test(animated_refits), cmocka_unit_test(cameras), cmocka_unit_test(errors),
         cmocka_unit_test(timing_example), cmocka_unit_test(qbvh_all_effects), cmocka_unit_test(qbvh_effects_obeyed),
-        cmocka_unit_test(qbvh_animated),
+        cmocka_unit_test(qbvh_animated), cmocka_unit_test(tlist_all_effects), cmocka_unit_test(tlist_heads_save_work),
+        cmocka_unit_test(tlist_animated), cmocka_unit_test(tlist_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

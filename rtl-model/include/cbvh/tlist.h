@@ -90,6 +90,15 @@ uint64_t cbvh_tlists_bytes(const cbvh_tlists *L);
  * y) and its sign; 8: the three signs (-0 counts as negative). */
 int cbvh_tlist_pick(const cbvh_tlists *L, const cbvh_ray *ray);
 
+/* The direction class of list l (docs/tlist.md §3): its sorting direction
+ * dir (+-e_a, or (+-1, +-1, +-1) for octants) and the extreme rays gen[] of the
+ * closure of the directions cbvh_tlist_pick assigns to it (returns how many:
+ * 6 for 1 list, 5 for 2, 4 for sextants, 3 for octants; 0 for a bad nlists). */
+int cbvh_tlist_cone(int nlists, int l, float dir[3], float gen[6][3]);
+/* Back-face culling rule: 1 iff cbvh_tri_facing <= 0 at every extreme ray of
+ * list l's cone, i.e. no direction of the list sees the triangle's front. */
+int cbvh_tlist_culled(int nlists, int l, const cbvh_tri *t);
+
 /* Traverse list `l` from element `head` (0 = the list's start).  Same result
  * definition as cbvh_trace_bvh (closest = smallest (t bits, triangle index)),
  * so hits equal the float BVH's bit for bit.  The sphere unit culls with the
@@ -98,5 +107,39 @@ int cbvh_tlist_pick(const cbvh_tlists *L, const cbvh_ray *ray);
  * 0 or -1 (ray rejected by a unit). */
 int cbvh_trace_tlist(const cbvh_tlists *L, int l, uint32_t head, const cbvh_tri *tris, const cbvh_ray *ray,
                      cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st);
+
+/* ---- list heads (seed 004 §3; docs/tlist.md §7) ----------------------------
+ * Per-polygon heads.  For triangle t and list l, the head skips every element
+ * before the first triangle element that a ray of this class might hit:
+ *   origin o within distance `margin` of triangle t (the hit point it leaves
+ *   from, with its rounding error and offset), direction d in list l's cone
+ *   with d . n_t >= 0 (cbvh_tri_facing(d, t) <= 0: it leaves on the front
+ *   side or along the plane), tmin >= 0.
+ * SIMPLE skips only what lies entirely behind t's plane (more than margin);
+ * REGULAR also what lies behind one of the cone's facet planes through the
+ * triangle (moved back by margin).  Heads go into L->poly_head (replacing any).
+ * margin >= 0, finite.  0 or -1 + reason. */
+typedef enum { CBVH_TLIST_HEADS_SIMPLE = 1, CBVH_TLIST_HEADS_REGULAR = 2 } cbvh_tlist_heads_kind;
+int cbvh_tlists_poly_heads(cbvh_tlists *L, const cbvh_tri *tris, cbvh_tlist_heads_kind kind, float margin, char *err,
+                           size_t errlen);
+/* The element a secondary ray leaving triangle `from` starts at in list l:
+ * poly_head[from * nlists + l] when heads exist and the ray leaves on the
+ * front side (exact facing <= 0) with tmin >= 0, else 0.  The origin condition
+ * (within margin of the triangle) is the caller's. */
+uint32_t cbvh_tlist_poly_head(const cbvh_tlists *L, int l, uint32_t from, const cbvh_tri *tris, const cbvh_ray *ray);
+/* A margin for secondary rays whose origin is q = fl(fl(o + t d) + eps n)
+ * (host/effects.c): eps plus the rounding error of the hit point, where
+ * coord_max bounds |coordinate| of every vertex, incoming-ray origin and hit
+ * point.  docs/tlist.md §7.1. */
+float cbvh_tlist_hitpoint_margin(float eps, float coord_max);
+
+/* Per-screen-cell heads for primary rays of a pinhole camera: rays with
+ * origin exactly o, tmin >= 0 and a direction in the cone spanned by the four
+ * corner directions (given in order around the cell), widened by the angle
+ * tol (radians, >= 2^-30; covers pixel directions rounded just outside the
+ * cell).  head[l] = first element of list l that such a ray may need, for
+ * every list (len[l] when none).  0, or -1 on bad input (non-finite values). */
+int cbvh_tlist_cell_heads(const cbvh_tlists *L, const cbvh_tri *tris, const float o[3], const float corner[4][3],
+                          double tol, uint32_t head[CBVH_TLIST_MAX]);
 
 #endif

@@ -61,7 +61,7 @@ typedef struct {
 uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
                            cbvh_tri_result *out);
 
-/* Ray-sphere unit (unit 9, rtl-model/src/ray_sphere.c, docs/traversal.md §6):
+/* Ray-sphere unit (unit 9, rtl-model/src/ray_sphere.c, docs/traversal.md §10):
  * *hit = 1 iff the closed ball |p - c| <= r meets the segment o + t d,
  * t in [tmin, tmax] (tmax may be +Inf), decided exactly.  Status as the box
  * unit for the ray (NaN/Inf, zero direction); NaN/Inf c or r, or r < 0 (sign

@@ -1,0 +1,102 @@
+/* Node-pair decode for the traversal (docs/traversal.md §9).  Internal to
+ * rtl-model.  The traversal needs, per child, only the leaf bit, the pointer
+ * and the relative coordinates r, s of each axis (the box unit's planes are
+ * u + r 2^e and u + s 2^e under the node's context); the decoded child
+ * bounds clb (and never cub) only for children it pushes.
+ *
+ * cbvh_fast_pair_decode handles 64-bit nodes (N <= 6) whose decode by the
+ * unit (cbvh_nodepair_decode) returns status 0: valid parameters and
+ * contexts, no reserved bit set, empty children with zero codes, r < s on
+ * every axis.  It then returns 1 with the same leaf, empty, ptr as the unit,
+ * and r, s equal to cbvh_axis_store_codes(RELATIVE) of the unit's outputs
+ * (s = 0 read as 2^N), as the traversal used them.  Otherwise it returns 0
+ * and the caller runs the unit.  tests/traversal/test_box_f64.c compares
+ * both on random and hard node pairs. */
+#ifndef CBVH_DECODE_FAST_H
+#define CBVH_DECODE_FAST_H
+
+#include "cbvh/datapath.h"
+#include "grid.h"
+#include "ray_box_f64.h"
+
+typedef struct {
+    int leaf, empty;
+    uint32_t ptr;
+    uint32_t r[3], s[3];   /* relative coordinates, s in [1, 2^N] */
+    uint32_t lc[3], uc[3]; /* the stored codes */
+} cbvh_fast_child;
+
+/* 1 if the context passes cbvh_axis_ctx_check (for valid parameters). */
+static inline int cbvh_fast_ctx_ok(const cbvh_params *p, const cbvh_axis_ctx *c) {
+    return c->scale >= p->min_scale && c->parent_scale <= CBVH_SCALE_CEIL && c->parent_scale >= c->scale &&
+           c->lb_mod <= cbvh_grid_mask(p) && !(cbvh_f32_is_nan_or_inf(c->clb) && c->clb != CBVH_F32_NEG_INF);
+}
+
+/* pmod of the decoder (axis_decoder.c) for a valid context. */
+static inline uint32_t cbvh_fast_pmod(const cbvh_params *p, const cbvh_axis_ctx *c) {
+    int shift = c->parent_scale - c->scale;
+    return shift >= p->quant_bits ? 0 : (c->lb_mod << shift) & cbvh_grid_mask(p);
+}
+
+static inline uint64_t cbvh_fast_load_le64(const uint8_t *b) {
+    return (uint64_t)b[0] | (uint64_t)b[1] << 8 | (uint64_t)b[2] << 16 | (uint64_t)b[3] << 24 |
+           (uint64_t)b[4] << 32 | (uint64_t)b[5] << 40 | (uint64_t)b[6] << 48 | (uint64_t)b[7] << 56;
+}
+
+static inline int cbvh_fast_pair_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
+                                        const uint8_t *bytes, cbvh_fast_child ch[2]) {
+    int n = p->quant_bits;
+    if (n < CBVH_N_MIN || n > 6 || p->min_scale < CBVH_SCALE_FLOOR || p->min_scale > CBVH_SCALE_CEIL) return 0;
+    uint32_t mask = cbvh_grid_mask(p), full = mask + 1u;
+    uint32_t pmod[3];
+    for (int a = 0; a < 3; a++) {
+        if (!cbvh_fast_ctx_ok(p, &ctx->axis[a])) return 0;
+        pmod[a] = enc == CBVH_ENC_MODULO ? cbvh_fast_pmod(p, &ctx->axis[a]) : 0; /* relative: r, s = codes */
+    }
+    int pp = 6 * n + 1;                     /* pointer position */
+    int pb = 64 - pp < 32 ? 64 - pp : 32;   /* pointer bits */
+    uint64_t ones = (UINT64_C(1) << pb) - 1u;
+    for (int c = 0; c < 2; c++) {
+        uint64_t w = cbvh_fast_load_le64(bytes + 8 * c);
+        if (pp + pb < 64 && (w >> (pp + pb)) != 0) return 0; /* reserved bits */
+        cbvh_fast_child *o = &ch[c];
+        o->leaf = (int)((w >> (pp - 1)) & 1u);
+        o->ptr = (uint32_t)((w >> pp) & ones);
+        o->empty = o->leaf && o->ptr == ones;
+        if (o->empty) {
+            if (w & ((UINT64_C(1) << (pp - 1)) - 1u)) return 0; /* codes of an empty child */
+            continue;
+        }
+        for (int a = 0; a < 3; a++) {
+            uint32_t lc = (uint32_t)(w >> (2 * a * n)) & mask, uc = (uint32_t)(w >> (2 * a * n + n)) & mask;
+            uint32_t r = (lc - pmod[a]) & mask, s = (uc - pmod[a]) & mask;
+            if (s == 0) s = full;
+            if (r >= s) return 0; /* INVERTED: the unit rejects */
+            o->lc[a] = lc;
+            o->uc[a] = uc;
+            o->r[a] = r;
+            o->s[a] = s;
+        }
+    }
+    return 1;
+}
+
+/* The context of child c along axis a, as cbvh_axis_child_ctx gives it from
+ * the unit's decode: {scale, child_scale(s - r), (r + pmod) mod 2^N,
+ * clb = RD(u + r 2^e)}.  plo: u + r 2^e exactly in binary64 (or NULL); clb is
+ * rounded from it when the result is normal or zero, else the unit
+ * (cbvh_axis_decode) computes it. */
+static inline void cbvh_fast_child_ctx(const cbvh_params *p, cbvh_encoding enc, const cbvh_axis_ctx *pc,
+                                       const cbvh_fast_child *fc, int a, const double *plo, cbvh_axis_ctx *cc) {
+    uint32_t r = fc->r[a];
+    cc->parent_scale = pc->scale;
+    cc->scale = cbvh_grid_child_scale(p, pc->scale, fc->s[a] - r);
+    cc->lb_mod = (r + cbvh_fast_pmod(p, pc)) & cbvh_grid_mask(p);
+    if (!plo || !cbvh_rbf_rd32(*plo, &cc->clb)) {
+        cbvh_axis_code code;
+        cbvh_axis_decode(p, enc, pc, fc->lc[a], fc->uc[a], &code);
+        cc->clb = code.clb;
+    }
+}
+
+#endif

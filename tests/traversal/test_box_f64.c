@@ -1,0 +1,410 @@
+/* The traversal's fast paths (docs/traversal.md §9) against the units:
+ *   - the ray-box unit's binary64 filter (rtl-model/src/ray_box_f64.h) on
+ *     float planes and on grid planes u + r 2^e: whenever it decides, hit and
+ *     t_near equal the exact path's (cbvh_ray_box_*_exact_only) bit for bit;
+ *     the claim that a grid plane is exact in binary64 is checked with an
+ *     error-free sum (2Sum); the two-box version (cbvh_rbf_box2) equals the
+ *     one-box version lane by lane;
+ *   - the node-pair decode for the traversal (rtl-model/src/decode_fast.h):
+ *     accepts exactly the pairs the unit decodes with status 0 (N <= 6) and
+ *     then gives the same leaf/empty/pointer, relative coordinates and child
+ *     contexts as cbvh_nodepair_decode + cbvh_axis_child_ctx;
+ *   - and the filter decides nearly all scene-like inputs (so the comparison
+ *     is not vacuous and the speed-up is real).
+ * Inputs: random values over wide exponent ranges plus hard cases - plane
+ * distances exactly on the M-bit grid and one binary32 ulp beside it, origins
+ * on planes, power-of-two directions, zero / subnormal / huge bounds, -Inf
+ * context bounds, random and corrupted node-pair bytes. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../rtl-model/src/decode_fast.h"
+#include "../../rtl-model/src/ray_box_f64.h"
+#include "../../rtl-model/src/ray_prep.h"
+
+#ifdef CBVH_SANITIZE
+#define NBOX 300000
+#define NPAIR 200000
+#else
+#define NBOX 2000000
+#define NPAIR 1000000
+#endif
+
+static long failures;
+static uint64_t rs = 0x2545F4914F6CDD1Du;
+static uint64_t rnd(void) {
+    rs ^= rs << 13;
+    rs ^= rs >> 7;
+    rs ^= rs << 17;
+    return rs;
+}
+static uint32_t below(uint32_t n) { return (uint32_t)(rnd() % n); }
+
+static cbvh_f32 fbits(float f) {
+    cbvh_f32 b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+static float bfloat(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+/* A binary32 pattern with exponent near emid; specials when wide. */
+static cbvh_f32 rf(int emid, int spread, int wide) {
+    uint32_t k = wide ? below(40) : 10 + below(30);
+    cbvh_f32 sign = (rnd() & 1) ? CBVH_F32_SIGN : 0;
+    if (k == 0) return sign;
+    if (k == 1) return sign | (1 + below(0x7FFFFF));
+    if (k == 2) return sign | CBVH_F32_MAX;
+    if (k == 3) return sign | CBVH_F32_POS_INF;
+    int e = emid - spread + (int)below((uint32_t)(2 * spread + 1));
+    if (e < -126) e = -126;
+    if (e > 127) e = 127;
+    uint32_t frac = k < 7 ? 0 : k < 10 ? below(8) << 20 : (uint32_t)(rnd() & CBVH_F32_FRAC);
+    return sign | ((uint32_t)(e + 127) << 23) | frac;
+}
+
+/* A direction component: random, power of two, few bits, sometimes zero. */
+static cbvh_f32 rdir(int wide) {
+    uint32_t k = below(16);
+    if (k == 0 && wide) return (rnd() & 1) ? CBVH_F32_SIGN : 0;
+    if (k < 4 && wide) return ((rnd() & 1) ? CBVH_F32_SIGN : 0) | ((uint32_t)(127 - 3 + below(7)) << 23); /* 2^k */
+    return rf(0, wide ? 60 : 3, wide);
+}
+
+/* Plane at which the distance from o along d is exactly the M-bit value t
+ * (when representable as binary32), or one ulp beside it. */
+static cbvh_f32 plane_on_grid(cbvh_f32 o, cbvh_f32 d, int M, int nudge) {
+    int mb = M < 18 ? M : 18 - (int)below(3); /* bits of t: o + t d stays within 24 bits */
+    double t = (double)(int)(below(1u << mb) | (1u << (mb - 1))) * (double)(1 << below(8)) / (double)(1 << 12);
+    if (rnd() & 1) t = -t;
+    double p = (double)bfloat(o) + t * (double)bfloat(d);
+    float pf = (float)p;
+    if (nudge) pf = nextafterf(pf, (rnd() & 1) ? 1e30f : -1e30f);
+    return fbits(pf);
+}
+
+/* cbvh_rbf_box2 on (box, other box) equals cbvh_rbf_box on each lane. */
+static double prev_lo[3], prev_hi[3];
+static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], const double hi[3], int dec, int hit,
+                       double tn, long i) {
+    double l2[3][2], h2[3][2], t2[2], tb = 0;
+    int hit2[2], hb = 0;
+    for (int a = 0; a < 3; a++) {
+        l2[a][0] = lo[a];
+        h2[a][0] = hi[a];
+        l2[a][1] = prev_lo[a];
+        h2[a][1] = prev_hi[a];
+    }
+    int decb = cbvh_rbf_box(p, tmax, prev_lo, prev_hi, &hb, &tb);
+    int d2 = cbvh_rbf_box2(p, tmax, (const double(*)[2])l2, (const double(*)[2])h2, hit2, t2);
+    if (d2 != (dec | decb << 1) || (dec && (hit2[0] != hit || t2[0] != tn)) ||
+        (decb && (hit2[1] != hb || t2[1] != tb))) {
+        if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2 differs from cbvh_rbf_box\n", i);
+    }
+    memcpy(prev_lo, lo, sizeof prev_lo);
+    memcpy(prev_hi, hi, sizeof prev_hi);
+}
+
+static int hit_ok(int decided, int hit, double tn, uint32_t st, const cbvh_box_result *ex) {
+    if (!decided) return 1;
+    if (st) return !hit; /* a rejected box is a miss for the traversal */
+    if (hit != ex->hit) return 0;
+    return !hit || cbvh_rbf_to_f32(tn == 0 ? 0.0 : tn) == ex->t_near;
+}
+
+/* scene: no power-of-two or zero direction components (where an exact
+ * quotient often lands on the grid and the filter leaves it to the unit) */
+static void make_ray(cbvh_ray *r, int wide, int scene, int M, int *mout) {
+    for (int a = 0; a < 3; a++) {
+        r->o[a] = rf(0, wide ? 40 : 4, wide && below(4) == 0);
+        r->d[a] = rdir(!scene);
+    }
+    if (r->d[0] == 0 && r->d[1] == 0 && r->d[2] == 0) r->d[0] = fbits(1.0f);
+    uint32_t k = below(8);
+    r->tmin = k == 0 ? CBVH_F32_SIGN : k == 1 ? rf(0, 6, 0) : 0;
+    k = below(8);
+    r->tmax = k < 5 ? CBVH_F32_POS_INF : k == 5 ? rf(0, 6, 0) & ~CBVH_F32_SIGN : rf(2, 4, 0);
+    *mout = M ? M : CBVH_MANT_MIN + (int)below(CBVH_MANT_MAX - CBVH_MANT_MIN + 1);
+}
+
+static void test_float_boxes(void) {
+    long decided = 0, typical_total = 0, typical_decided = 0;
+    for (long i = 0; i < NBOX; i++) {
+        int wide = (i & 3) == 0, M;
+        cbvh_ray ray;
+        make_ray(&ray, wide, (int)(i & 1), (i & 2) ? 24 : 0, &M);
+        cbvh_f32 lo[3], hi[3];
+        int hard = (i & 3) == 2; /* typical (i odd): no hard cases */
+        for (int a = 0; a < 3; a++) {
+            uint32_t k = hard ? below(3) : 2 + below(8);
+            cbvh_f32 x, y;
+            if (k == 0) {
+                /* a few-bit direction and a few-bit origin: o + t d is often
+                 * exact in binary32, so t lies exactly on the M-bit grid
+                 * while 1/d is inexact (t^ a few ulps beside t) */
+                ray.d[a] = fbits((float)((1 + 2 * (int)below(4)) * ((rnd() & 1) ? 1 : -1)) * ldexpf(1.0f, (int)below(9) - 4));
+                ray.o[a] = fbits((float)((int)below(64) - 32) * ldexpf(1.0f, (int)below(5) - 2));
+                x = plane_on_grid(ray.o[a], ray.d[a], M, 0);
+                y = plane_on_grid(ray.o[a], ray.d[a], M, below(2));
+            } else if (k == 1 && below(2)) {
+                /* distances around 2^-126 (the binary32 subnormal border) */
+                ray.o[a] = rf(-110, 3, 0);
+                ray.d[a] = rf(0, 2, 0);
+                x = ray.o[a] + below(300);
+                y = x + below(300);
+                if ((x ^ ray.o[a]) >> 23 || (y ^ ray.o[a]) >> 23) x = y = ray.o[a]; /* stay in o's binade */
+            } else if (k == 1) {
+                x = ray.o[a]; /* origin on a plane */
+                y = rf(0, wide ? 40 : 4, 0);
+            } else {
+                x = rf(0, wide ? 40 : 4, wide && below(4) == 0);
+                y = rf(0, wide ? 40 : 4, wide && below(4) == 0);
+            }
+            if ((!hard || below(16)) && cbvh_f32_cmp(x, y) > 0) { /* hard: sometimes inverted */
+                cbvh_f32 t = x;
+                x = y;
+                y = t;
+            }
+            lo[a] = x;
+            hi[a] = y;
+        }
+        cbvh_box_result ex;
+        uint32_t st = cbvh_ray_box_float_exact_only(&ray, M, lo, hi, &ex);
+        cbvh_rbf_ray p;
+        cbvh_rbf_prepare(&ray, M, &p);
+        double dlo[3], dhi[3];
+        for (int a = 0; a < 3; a++) {
+            dlo[a] = bfloat(lo[a]);
+            dhi[a] = bfloat(hi[a]);
+        }
+        int hit = 0;
+        double tn = 0;
+        int dec = cbvh_rbf_box(&p, (double)bfloat(ray.tmax), dlo, dhi, &hit, &tn);
+        check_pair(&p, (double)bfloat(ray.tmax), dlo, dhi, dec, hit, tn, i);
+        decided += dec;
+        if (!hit_ok(dec, hit, tn, st, &ex)) {
+            if (failures++ < 10)
+                printf("FAIL float box %ld: M=%d filter hit=%d tn=%a, exact st=%x hit=%d tn=%08x\n", i, M, hit, tn,
+                       st, ex.hit, ex.t_near);
+        }
+        if (i & 1) {
+            typical_total++;
+            typical_decided += dec;
+        }
+    }
+    printf("float planes: %d boxes, filter decided %ld (scene-like: %.4f)\n", NBOX, decided,
+           (double)typical_decided / (double)typical_total);
+    if ((double)typical_decided < 0.95 * (double)typical_total) {
+        printf("FAIL: the filter decides too few scene-like float boxes\n");
+        failures++;
+    }
+}
+
+/* 1 if a + b is exact in binary64 (2Sum error term zero). */
+static int sum_exact(double a, double b) {
+    double s = a + b, bb = s - a;
+    return (a - (s - bb)) + (b - bb) == 0;
+}
+
+/* The decoder's clb = RD(u + r 2^e) (axis_decoder.c, general path). */
+static cbvh_f32 unit_rd(cbvh_f32 u, uint32_t r, int e) {
+    if (u == CBVH_F32_NEG_INF) return cbvh_grid_add_dyadic(-1, 128, (int64_t)r, e, CBVH_RND_DOWN);
+    int sign, ue;
+    uint32_t m;
+    cbvh_grid_break(u, &sign, &m, &ue);
+    return cbvh_grid_add_dyadic(sign ? -(int64_t)m : (int64_t)m, ue, (int64_t)r, e, CBVH_RND_DOWN);
+}
+
+static void test_grid_boxes(void) {
+    long decided = 0, exact_axes = 0, typical_total = 0, typical_decided = 0;
+    for (long i = 0; i < NBOX; i++) {
+        int wide = (i & 3) == 0, M;
+        cbvh_ray ray;
+        make_ray(&ray, wide, (int)(i & 1), (i & 2) ? 24 : 0, &M);
+        cbvh_grid_axis g[3];
+        cbvh_rbf_axis ax[3];
+        double dlo[3], dhi[3];
+        int all_exact = 1;
+        int hard = (i & 3) == 2, valid = 1;
+        for (int a = 0; a < 3; a++) {
+            uint32_t k = hard ? below(7) : 6 + below(6);
+            g[a].u = k == 0 ? CBVH_F32_NEG_INF : k == 1 ? (rnd() & 1) * CBVH_F32_SIGN : rf(0, wide ? 60 : 4, 0);
+            int eu = (int)((g[a].u >> 23) & 0xFF) - 127;
+            int e = wide ? (int)below(253) - 126 : eu - 20 + (int)below(24);
+            if (k == 5) { /* sums near the binary32 range ends (subnormal / overflow) */
+                uint32_t kk = below(3);
+                g[a].u = kk == 0 ? rf(126, 1, 0) : kk == 1 ? rf(-126, 1, 0) : ((rnd() & 1) * CBVH_F32_SIGN) | below(1u << 23);
+                eu = (int)((g[a].u >> 23) & 0xFF) - 127;
+                e = eu - (int)below(30);
+            }
+            if (k == 2) e = eu - 23 - 29 + (int)below(3); /* at the exactness limits */
+            if (k == 3) e = eu - 23 + 42 - (int)below(3);
+            if (e < -126) e = -126;
+            if (e > 126) e = 126;
+            g[a].e = e;
+            uint32_t n = 3 + below(8), full = 1u << n;
+            g[a].r = below(full);
+            g[a].s = g[a].r + 1 + below(full - g[a].r);
+            if (hard && below(64) == 0) g[a].s = g[a].r; /* inverted */
+            valid &= g[a].r < g[a].s;
+            if (k == 4) { /* origin on the lower plane when representable */
+                double pl = (double)bfloat(g[a].u) + (double)g[a].r * ldexp(1.0, e);
+                if ((double)(float)pl == pl) ray.o[a] = fbits((float)pl);
+            }
+            ax[a] = cbvh_rbf_axis_prep(g[a].u, g[a].e);
+            dlo[a] = ax[a].u + (double)g[a].r * ax[a].step;
+            dhi[a] = ax[a].u + (double)g[a].s * ax[a].step;
+            if (ax[a].exact) {
+                exact_axes++;
+                if (!sum_exact(ax[a].u, (double)g[a].r * ax[a].step) ||
+                    !sum_exact(ax[a].u, (double)g[a].s * ax[a].step) || ax[a].step != ldexp(1.0, e)) {
+                    if (failures++ < 10) printf("FAIL grid axis claimed exact: u=%08x e=%d r=%u\n", g[a].u, e, g[a].r);
+                }
+            }
+            all_exact &= ax[a].exact;
+        }
+        cbvh_box_result ex;
+        uint32_t st = cbvh_ray_box_exact_only(&ray, M, g, &ex);
+        cbvh_rbf_ray p;
+        cbvh_rbf_prepare(&ray, M, &p);
+        int hit = 0;
+        double tn = 0;
+        /* the traversal calls the filter only for decoded boxes (r < s) */
+        int dec = valid && all_exact && cbvh_rbf_box(&p, (double)bfloat(ray.tmax), dlo, dhi, &hit, &tn);
+        if (valid && all_exact) check_pair(&p, (double)bfloat(ray.tmax), dlo, dhi, dec, hit, tn, i);
+        decided += dec;
+        if (!hit_ok(dec, hit, tn, st, &ex)) {
+            if (failures++ < 10)
+                printf("FAIL grid box %ld: M=%d filter hit=%d tn=%a, exact st=%x hit=%d tn=%08x\n", i, M, hit, tn, st,
+                       ex.hit, ex.t_near);
+        }
+        /* the decoded lower bound RD(u + r 2^e), as the traversal rounds it */
+        for (int a = 0; a < 3; a++) {
+            cbvh_f32 c;
+            if (!ax[a].exact || !cbvh_rbf_rd32(dlo[a], &c)) continue;
+            cbvh_f32 want = unit_rd(g[a].u, g[a].r, g[a].e);
+            if (c != want) {
+                if (failures++ < 10) printf("FAIL rd32: u=%08x e=%d r=%u: %08x, unit %08x\n", g[a].u, g[a].e, g[a].r, c, want);
+            }
+        }
+        if (i & 1) {
+            typical_total++;
+            typical_decided += dec;
+        }
+    }
+    printf("grid planes: %d boxes, %ld axes exact in binary64, filter decided %ld (scene-like: %.4f)\n", NBOX,
+           exact_axes, decided, (double)typical_decided / (double)typical_total);
+    if ((double)typical_decided < 0.9 * (double)typical_total) {
+        printf("FAIL: the filter decides too few scene-like grid boxes\n");
+        failures++;
+    }
+}
+
+static void random_ctx(const cbvh_params *p, cbvh_axis_ctx *c) {
+    uint32_t mask = (1u << p->quant_bits) - 1u;
+    c->scale = p->min_scale + (int)below((uint32_t)(127 - p->min_scale));
+    if (c->scale > 126) c->scale = 126;
+    c->parent_scale = c->scale + (int)below(12);
+    if (c->parent_scale > 126) c->parent_scale = 126;
+    c->lb_mod = below(mask + 1u);
+    uint32_t k = below(40);
+    c->clb = k == 0 ? CBVH_F32_NEG_INF : k == 1 ? 0 : rf(c->scale + 20, 8, 0);
+    if ((c->clb & 0x7F800000u) == 0x7F800000u && c->clb != CBVH_F32_NEG_INF) c->clb = CBVH_F32_MAX;
+    /* rare invalid contexts */
+    k = below(200);
+    if (k == 0) c->clb = CBVH_F32_POS_INF;
+    if (k == 1) c->lb_mod = mask + 1u;
+    if (k == 2) c->parent_scale = c->scale - 1;
+    if (k == 3) c->scale = p->min_scale - 1;
+}
+
+static void test_pair_decode(void) {
+    long accepted = 0;
+    for (long i = 0; i < NPAIR; i++) {
+        cbvh_params p = {3 + (int)below(4), below(4) == 0 ? -126 : -30 + (int)below(20)};
+        cbvh_encoding enc = (cbvh_encoding)(rnd() & 1);
+        cbvh_node_ctx ctx;
+        for (int a = 0; a < 3; a++) random_ctx(&p, &ctx.axis[a]);
+        int n = p.quant_bits, pp = 6 * n + 1, pb = 64 - pp < 32 ? 64 - pp : 32;
+        uint8_t bytes[16];
+        for (int c = 0; c < 2; c++) {
+            uint64_t w = rnd() & ((UINT64_C(1) << (6 * n)) - 1u);
+            if (below(4)) { /* mostly valid codes: r < s on every axis */
+                uint32_t mask = (1u << n) - 1u;
+                w = 0;
+                for (int a = 0; a < 3; a++) {
+                    uint32_t r = below(mask + 1u), s = r + 1 + below(mask + 1u - r);
+                    uint32_t pm = enc == CBVH_ENC_MODULO && ctx.axis[a].parent_scale >= ctx.axis[a].scale
+                                      ? cbvh_fast_pmod(&p, &ctx.axis[a])
+                                      : 0;
+                    w |= (uint64_t)((r + pm) & mask) << (2 * a * n) | (uint64_t)((s + pm) & mask) << (2 * a * n + n);
+                }
+            }
+            uint32_t k = below(16);
+            uint64_t ones = (UINT64_C(1) << pb) - 1u;
+            if (k == 0) w = 0; /* empty */
+            uint64_t ptr = k < 2 ? ones : rnd() & ones;
+            w |= (uint64_t)(k < 2 || (rnd() & 1)) << (pp - 1) | ptr << pp;
+            if (below(32) == 0) w |= UINT64_C(1) << (pp + below((uint32_t)(64 - pp))); /* reserved or pointer bit */
+            for (int b = 0; b < 8; b++) bytes[8 * c + b] = (uint8_t)(w >> (8 * b));
+        }
+        cbvh_child_out ch[2];
+        uint32_t st = cbvh_nodepair_decode(&p, enc, &ctx, bytes, ch);
+        cbvh_fast_child fc[2];
+        int ok = cbvh_fast_pair_decode(&p, enc, &ctx, bytes, fc);
+        /* accepted => the unit decodes with status 0; the converse may fail
+         * only for a pair of two empty children under an invalid context
+         * (the unit never reads the context then) */
+        int both_empty = 1;
+        for (int c = 0; c < 2; c++) both_empty &= ch[c].empty;
+        if ((ok && st) || (!ok && !st && !both_empty)) {
+            if (failures++ < 10) printf("FAIL pair %ld: fast decode %d, unit status %x\n", i, ok, st);
+            continue;
+        }
+        if (!ok) continue;
+        accepted++;
+        for (int c = 0; c < 2; c++) {
+            if (fc[c].leaf != ch[c].leaf || fc[c].empty != ch[c].empty || fc[c].ptr != ch[c].ptr) {
+                if (failures++ < 10) printf("FAIL pair %ld child %d: leaf/empty/ptr differ\n", i, c);
+            }
+            if (ch[c].empty) continue;
+            for (int a = 0; a < 3; a++) {
+                uint32_t r, s;
+                cbvh_axis_store_codes(&p, CBVH_ENC_RELATIVE, &ctx.axis[a], &ch[c].axis[a], &r, &s);
+                if (s == 0) s = 1u << n;
+                cbvh_rbf_axis ax = cbvh_rbf_axis_prep(ctx.axis[a].clb, ctx.axis[a].scale);
+                double plo = ax.u + (double)fc[c].r[a] * ax.step;
+                cbvh_axis_ctx want = cbvh_axis_child_ctx(&ctx.axis[a], &ch[c].axis[a]), got;
+                cbvh_fast_child_ctx(&p, enc, &ctx.axis[a], &fc[c], a, ax.exact ? &plo : NULL, &got);
+                if (r != fc[c].r[a] || s != fc[c].s[a] || memcmp(&want, &got, sizeof want)) {
+                    if (failures++ < 10)
+                        printf("FAIL pair %ld child %d axis %d: r %u/%u s %u/%u ctx (%d %d %u %08x)/(%d %d %u %08x)\n", i,
+                               c, a, fc[c].r[a], r, fc[c].s[a], s, got.parent_scale, got.scale, got.lb_mod, got.clb,
+                               want.parent_scale, want.scale, want.lb_mod, want.clb);
+                }
+            }
+        }
+    }
+    printf("node pairs: %d, %ld decoded with status 0 by both\n", NPAIR, accepted);
+    if (accepted < NPAIR / 10) {
+        printf("FAIL: too few valid pairs\n");
+        failures++;
+    }
+}
+
+int main(void) {
+    test_float_boxes();
+    test_grid_boxes();
+    test_pair_decode();
+    if (failures) {
+        printf("test_box_f64: %ld failures\n", failures);
+        return 1;
+    }
+    printf("test_box_f64: all passed\n");
+    return 0;
+}
