@@ -446,11 +446,21 @@ static int build_tlists(tracer *T, char *err, size_t errlen) {
     sc.tris = T->tris;
     sc.nmorph = 0;
     sc.nkeys = 0;
+    int nlists = T->o->tlist.p.nlists ? T->o->tlist.p.nlists : 6;
+    /* Per-polygon heads cost about 2-10 us per triangle and list to
+     * precompute; past this size that is many minutes: refuse up front. */
+    if (T->o->tlist.poly_heads && (uint64_t)sc.ntris * (uint64_t)nlists > CBVH_FX_POLY_HEADS_MAX) {
+        snprintf(err, errlen,
+                 "tlist: per-polygon heads for %u triangles x %d lists exceed the limit of %llu (minutes of "
+                 "precomputation); drop ':heads' or use fewer lists",
+                 sc.ntris, nlists, (unsigned long long)CBVH_FX_POLY_HEADS_MAX);
+        return -1;
+    }
     cbvh_bsh_params bp;
     cbvh_bsh_default_params(&bp);
     if (cbvh_bsh_build(&sc, &bp, &T->bsh, err, errlen)) return -1;
     cbvh_tlist_params lp = T->o->tlist.p;
-    if (!lp.nlists) lp.nlists = 6;
+    lp.nlists = nlists;
     if (cbvh_tlists_build(&T->bsh, &sc, &lp, &T->tl, err, errlen)) {
         cbvh_bsh_free(&T->bsh);
         return -1;

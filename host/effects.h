@@ -30,6 +30,9 @@ typedef struct {
     int cell_heads;      /* per-screen-cell list heads for pinhole primary rays */
 } cbvh_tlist_opts;
 
+/* Largest triangles x lists for which format tlist precomputes per-polygon heads. */
+#define CBVH_FX_POLY_HEADS_MAX 16000000u
+
 /* Parses "tlist[:L][:earliest|:latest][:cull][:heads]" (L = 1, 2, 6, 8;
  * defaults 6 lists, earliest first, no culling, no heads; "heads" = both kinds).
  * 0, or -1 with a one-line reason. */
