@@ -15,18 +15,8 @@
 #include <time.h>
 
 #include "cbvh/qbvh.h"
+#define BENCH_NAME "bench_qbvh"
 #include "bench_rays.h"
-#include "scene_load.h"
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-static void die(const char *what, const char *err) {
-    fprintf(stderr, "bench_qbvh: %s: %s\n", what, err);
-    exit(1);
-}
 
 /* Levels below the root of the binary tree (the stack size a traversal must
  * allocate is bounded by it; the paper's "stack size"). */
@@ -67,13 +57,10 @@ int main(int argc, char **argv) {
     int nrays = 20000, reps = 3, ns = 0;
     const char *specs[64];
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
-            nrays = atoi(argv[++i]);
-            if (nrays < 2 || nrays > 10000000) die("--rays", "must be 2..10000000");
-        } else if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
-            reps = atoi(argv[++i]);
-            if (reps < 1 || reps > 100) die("--reps", "must be 1..100");
-        } else if (argv[i][0] == '-') {
+        if (int_option(argc, argv, &i, "--rays", 2, 10000000, &nrays) ||
+            int_option(argc, argv, &i, "--reps", 1, 100, &reps))
+            continue;
+        if (argv[i][0] == '-') {
             fprintf(stderr, "usage: bench_qbvh [--rays R] [--reps K] [SCENE...]\n");
             return 2;
         } else if (ns < 64) {
@@ -92,10 +79,9 @@ int main(int argc, char **argv) {
     char err[512];
     for (int si = 0; si < ns; si++) {
         cbvh_scene s;
-        if (cbvh_scene_open(specs[si], &s, err, sizeof err)) die(specs[si], err);
         cbvh_bvh b;
         cbvh_qbvh q;
-        if (cbvh_build_sah(&s, 0, 0, &b, err, sizeof err)) die("build", err);
+        load_scene(specs[si], &s, &b, "build");
         if (cbvh_qbvh_from_bvh(&b, &q, err, sizeof err)) die("collapse", err);
         if (cbvh_qbvh_check(&q, &s, err, sizeof err)) die("qbvh check", err);
         float lo[3], hi[3];
@@ -123,7 +109,7 @@ int main(int argc, char **argv) {
                 die(specs[si], "QBVH hit differs from the binary BVH");
         /* Node arrays in the same 40-byte SoA format for both trees. */
         double bk = (double)(leaves + inner) * CBVH_QBVH_NODE_BYTES / 1024, qk = (double)cbvh_qbvh_node_bytes(&q) / 1024;
-        const char *base = strrchr(specs[si], '/') ? strrchr(specs[si], '/') + 1 : specs[si];
+        const char *base = scene_base(specs[si]);
         char nodes[32], box[32], tri[32], depth[32];
         snprintf(depth, sizeof depth, "%u/%u", bvh_depth(&b), q.depth);
         snprintf(nodes, sizeof nodes, "%.1f/%.1f", (double)sb.nodes / nrays, (double)sq.nodes / nrays);

@@ -1,57 +1,113 @@
-/* The rays every traversal benchmark uses (same definition, so figures compare):
- * camera rays over a square image looking at the scene centre from outside its
- * box (first half) and random rays with origins in the box and directions
- * uniform on the sphere (second half); xorshift64, seeded by the caller. */
+/* What the traversal benchmarks share (same definitions, so figures compare):
+ *   - the rays: camera rays over a square image looking at the scene centre
+ *     from outside its box (first half) and random rays with origins in the box
+ *     and directions uniform on the sphere (second half); xorshift64, seeded by
+ *     the caller through rs;
+ *   - option parsing (--rays, --reps), scene loading + SAH float BVH, wall-clock
+ *     timing and the fatal-error exit.
+ * Define BENCH_NAME (the program name, for error messages) before including. */
 #ifndef CBVH_BENCH_RAYS_H
 #define CBVH_BENCH_RAYS_H
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cbvh/traverse.h"
+#include "scene_load.h"
+#include "test_util.h" /* fb, bf, xorshift64 (tests/common) */
+
+#ifndef BENCH_NAME
+#error "define BENCH_NAME before including bench_rays.h"
+#endif
 
 static uint64_t rs = 1; /* generator state: set it before make_rays */
 
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
+static inline uint64_t rnd(void) { return tu_xorshift64(&rs); }
+static inline float unit(void) { return tu_unit_f(&rs); }
+
+static inline double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
-static float unit(void) { return (float)((double)(rnd() >> 11) / 9007199254740992.0); }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
+static inline void die(const char *what, const char *err) {
+    fprintf(stderr, BENCH_NAME ": %s: %s\n", what, err);
+    exit(1);
 }
 
-static void make_rays(const float lo[3], const float hi[3], int n, cbvh_ray *rays) {
+/* argv[*i] == name with a value in [lo, hi]: store it, step past it, return 1. */
+static inline int int_option(int argc, char **argv, int *i, const char *name, int lo, int hi, int *val) {
+    if (strcmp(argv[*i], name) || *i + 1 >= argc) return 0;
+    *val = atoi(argv[++*i]);
+    if (*val < lo || *val > hi) {
+        char msg[64];
+        snprintf(msg, sizeof msg, "must be %d..%d", lo, hi);
+        die(name, msg);
+    }
+    return 1;
+}
+
+/* Open a scene and build its binned-SAH float BVH; `build` names the step in
+ * the error message. */
+static inline void load_scene(const char *spec, cbvh_scene *s, cbvh_bvh *b, const char *build) {
+    char err[512];
+    if (cbvh_scene_open(spec, s, err, sizeof err)) die(spec, err);
+    if (cbvh_build_sah(s, 0, 0, b, err, sizeof err)) die(build, err);
+}
+
+/* File name of a scene spec, for the tables. */
+static inline const char *scene_base(const char *spec) {
+    const char *slash = strrchr(spec, '/');
+    return slash ? slash + 1 : spec;
+}
+
+/* The pinhole camera of make_rays for n rays: eye, forward w, right u, up v,
+ * ncam = n / 2 camera rays over a side x side image. */
+typedef struct {
+    float eye[3], w[3], u[3], v[3];
+    int side, ncam;
+} camera;
+
+static inline void camera_of(const float lo[3], const float hi[3], int n, camera *C) {
     float c[3], ext = 0;
     for (int a = 0; a < 3; a++) {
         c[a] = 0.5f * (lo[a] + hi[a]);
         if (hi[a] - lo[a] > ext) ext = hi[a] - lo[a];
     }
     if (ext <= 0) ext = 1;
-    int ncam = n / 2, side = (int)ceil(sqrt((double)ncam));
-    float eye[3] = {c[0] + 0.3f * ext, c[1] + 0.4f * ext, c[2] + 1.6f * ext};
-    float w[3], len = 0; /* forward, then right/up from the y axis */
-    for (int a = 0; a < 3; a++) w[a] = c[a] - eye[a], len += w[a] * w[a];
+    C->ncam = n / 2;
+    C->side = (int)ceil(sqrt((double)C->ncam));
+    float eye[3] = {c[0] + 0.3f * ext, c[1] + 0.4f * ext, c[2] + 1.6f * ext}, len = 0;
+    memcpy(C->eye, eye, sizeof eye);
+    for (int a = 0; a < 3; a++) C->w[a] = c[a] - eye[a], len += C->w[a] * C->w[a];
     len = sqrtf(len);
-    for (int a = 0; a < 3; a++) w[a] /= len;
-    float u[3] = {w[2], 0, -w[0]}, ul = sqrtf(u[0] * u[0] + u[2] * u[2]);
-    for (int a = 0; a < 3; a++) u[a] /= ul;
-    float v[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    for (int a = 0; a < 3; a++) C->w[a] /= len;
+    float u[3] = {C->w[2], 0, -C->w[0]}, ul = sqrtf(u[0] * u[0] + u[2] * u[2]);
+    for (int a = 0; a < 3; a++) C->u[a] = u[a] / ul;
+    C->v[0] = C->u[1] * C->w[2] - C->u[2] * C->w[1];
+    C->v[1] = C->u[2] * C->w[0] - C->u[0] * C->w[2];
+    C->v[2] = C->u[0] * C->w[1] - C->u[1] * C->w[0];
+}
+
+/* Direction through image point (X, Y) in pixels (pixel centres at k + 0.5). */
+static inline void cam_dir(const camera *C, float X, float Y, float d[3]) {
+    float px = X / (float)C->side * 2 - 1, py = Y / (float)C->side * 2 - 1;
+    for (int a = 0; a < 3; a++) d[a] = C->w[a] + 0.45f * (px * C->u[a] + py * C->v[a]);
+}
+
+static inline void make_rays(const float lo[3], const float hi[3], int n, cbvh_ray *rays) {
+    camera C;
+    camera_of(lo, hi, n, &C);
     for (int i = 0; i < n; i++) {
         cbvh_ray *r = &rays[i];
         float d[3], o[3];
-        if (i < ncam) {
-            float px = ((float)(i % side) + 0.5f) / (float)side * 2 - 1;
-            float py = ((float)(i / side) + 0.5f) / (float)side * 2 - 1;
-            for (int a = 0; a < 3; a++) {
-                o[a] = eye[a];
-                d[a] = w[a] + 0.45f * (px * u[a] + py * v[a]);
-            }
+        if (i < C.ncam) {
+            memcpy(o, C.eye, sizeof o);
+            cam_dir(&C, (float)(i % C.side) + 0.5f, (float)(i / C.side) + 0.5f, d);
         } else {
             float z = unit() * 2 - 1, phi = 6.2831853f * unit(), s = sqrtf(fmaxf(0, 1 - z * z));
             d[0] = s * cosf(phi);

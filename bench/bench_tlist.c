@@ -29,58 +29,11 @@
 #include <string.h>
 #include <time.h>
 
-#include "bench_rays.h"
 #include "cbvh/tlist.h"
-#include "scene_load.h"
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-static void die(const char *what, const char *err) {
-    fprintf(stderr, "bench_tlist: %s: %s\n", what, err);
-    exit(1);
-}
-static float bits_f(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
+#define BENCH_NAME "bench_tlist"
+#include "bench_rays.h"
 
 #define CELL 8
-
-/* The camera of make_rays (same float operations). */
-typedef struct {
-    float eye[3], w[3], u[3], v[3];
-    int side, ncam;
-} camera;
-
-static void camera_of(const float lo[3], const float hi[3], int n, camera *C) {
-    float c[3], ext = 0;
-    for (int a = 0; a < 3; a++) {
-        c[a] = 0.5f * (lo[a] + hi[a]);
-        if (hi[a] - lo[a] > ext) ext = hi[a] - lo[a];
-    }
-    if (ext <= 0) ext = 1;
-    C->ncam = n / 2;
-    C->side = (int)ceil(sqrt((double)C->ncam));
-    float eye[3] = {c[0] + 0.3f * ext, c[1] + 0.4f * ext, c[2] + 1.6f * ext}, len = 0;
-    memcpy(C->eye, eye, sizeof eye);
-    for (int a = 0; a < 3; a++) C->w[a] = c[a] - eye[a], len += C->w[a] * C->w[a];
-    len = sqrtf(len);
-    for (int a = 0; a < 3; a++) C->w[a] /= len;
-    float u[3] = {C->w[2], 0, -C->w[0]}, ul = sqrtf(u[0] * u[0] + u[2] * u[2]);
-    for (int a = 0; a < 3; a++) C->u[a] = u[a] / ul;
-    C->v[0] = C->u[1] * C->w[2] - C->u[2] * C->w[1];
-    C->v[1] = C->u[2] * C->w[0] - C->u[0] * C->w[2];
-    C->v[2] = C->u[0] * C->w[1] - C->u[1] * C->w[0];
-}
-
-static void cam_dir(const camera *C, float X, float Y, float d[3]) {
-    float px = X / (float)C->side * 2 - 1, py = Y / (float)C->side * 2 - 1;
-    for (int a = 0; a < 3; a++) d[a] = C->w[a] + 0.45f * (px * C->u[a] + py * C->v[a]);
-}
 
 typedef struct {
     cbvh_ray r;
@@ -96,10 +49,10 @@ static int make_secondary(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_ray
         cbvh_trav_stats st = {0};
         if (cbvh_trace_bvh(b, s->tris, &cam[i], 24, CBVH_TRAV_CLOSEST_FRONT, &h, &st) || !h.hit) continue;
         const cbvh_tri *tr = &s->tris[h.prim];
-        float t = bits_f(h.t), o[3], d[3], p[3], n[3], e1[3], e2[3], w[3];
+        float t = bf(h.t), o[3], d[3], p[3], n[3], e1[3], e2[3], w[3];
         for (int a = 0; a < 3; a++) {
-            o[a] = bits_f(cam[i].o[a]);
-            d[a] = bits_f(cam[i].d[a]);
+            o[a] = bf(cam[i].o[a]);
+            d[a] = bf(cam[i].d[a]);
             p[a] = o[a] + t * d[a];
             e1[a] = tr->v[1][a] - tr->v[0][a];
             e2[a] = tr->v[2][a] - tr->v[0][a];
@@ -190,13 +143,10 @@ int main(int argc, char **argv) {
     int nrays = 10000, reps = 2, ns = 0;
     const char *specs[64], *json = NULL;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
-            nrays = atoi(argv[++i]);
-            if (nrays < 2 || nrays > 10000000) die("--rays", "must be 2..10000000");
-        } else if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
-            reps = atoi(argv[++i]);
-            if (reps < 1 || reps > 100) die("--reps", "must be 1..100");
-        } else if (!strcmp(argv[i], "--json") && i + 1 < argc) {
+        if (int_option(argc, argv, &i, "--rays", 2, 10000000, &nrays) ||
+            int_option(argc, argv, &i, "--reps", 1, 100, &reps))
+            continue;
+        if (!strcmp(argv[i], "--json") && i + 1 < argc) {
             json = argv[++i];
         } else if (argv[i][0] == '-') {
             fprintf(stderr, "usage: bench_tlist [--rays R] [--reps K] [--json FILE] [SCENE...]\n");
@@ -212,10 +162,9 @@ int main(int argc, char **argv) {
     char err[512];
     for (int si = 0; si < ns; si++) {
         cbvh_scene s;
-        if (cbvh_scene_open(specs[si], &s, err, sizeof err)) die(specs[si], err);
-        const char *base = strrchr(specs[si], '/') ? strrchr(specs[si], '/') + 1 : specs[si];
         cbvh_bvh b;
-        if (cbvh_build_sah(&s, 0, 0, &b, err, sizeof err)) die("sah", err);
+        load_scene(specs[si], &s, &b, "sah");
+        const char *base = scene_base(specs[si]);
         double tb0 = now();
         cbvh_bsh h;
         if (cbvh_bsh_build(&s, NULL, &h, err, sizeof err)) die("bsh", err);

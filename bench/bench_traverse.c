@@ -24,8 +24,8 @@
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
 #include "cbvh/traverse.h"
+#define BENCH_NAME "bench_traverse"
 #include "bench_rays.h"
-#include "scene_load.h"
 
 #ifdef CBVH_HAVE_EMBREE
 #include <embree3/rtcore.h>
@@ -34,23 +34,6 @@
 #ifndef CBVH_SCENES_DIR
 #define CBVH_SCENES_DIR "scenes"
 #endif
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void die(const char *what, const char *err) {
-    fprintf(stderr, "bench_traverse: %s: %s\n", what, err);
-    exit(1);
-}
-
-static float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
 
 typedef struct {
     double rays_per_s;
@@ -150,13 +133,10 @@ int main(int argc, char **argv) {
     const char *specs[64];
     int ns = 0;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--rays") && i + 1 < argc) {
-            nrays = atoi(argv[++i]);
-            if (nrays < 2 || nrays > 10000000) die("--rays", "must be 2..10000000");
-        } else if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
-            reps = atoi(argv[++i]);
-            if (reps < 1 || reps > 100) die("--reps", "must be 1..100");
-        } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
+        if (int_option(argc, argv, &i, "--rays", 2, 10000000, &nrays) ||
+            int_option(argc, argv, &i, "--reps", 1, 100, &reps))
+            continue;
+        if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
             seed = strtoull(argv[++i], NULL, 0);
         } else if (argv[i][0] == '-') {
             fprintf(stderr, "usage: bench_traverse [--rays R] [--seed S] [--reps K] [SCENE...]\n");
@@ -181,9 +161,8 @@ int main(int argc, char **argv) {
     if (!rays) die("rays", "out of memory");
     for (int si = 0; si < ns; si++) {
         cbvh_scene s;
-        if (cbvh_scene_open(specs[si], &s, err, sizeof err)) die(specs[si], err);
         cbvh_bvh b;
-        if (cbvh_build_sah(&s, 0, 0, &b, err, sizeof err)) die("build", err);
+        load_scene(specs[si], &s, &b, "build");
         cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 1, 0};
         cbvh_tree t;
         if (cbvh_compress_topdown(&b, &o, &t, err, sizeof err)) die("compress", err);
@@ -193,7 +172,7 @@ int main(int argc, char **argv) {
 #ifdef CBVH_HAVE_EMBREE
         RTCScene sc = embree_scene(dev, &s);
 #endif
-        const char *base = strrchr(specs[si], '/') ? strrchr(specs[si], '/') + 1 : specs[si];
+        const char *base = scene_base(specs[si]);
         for (int half = 0; half < 2; half++) {
             const cbvh_ray *rr = rays + (half ? nrays / 2 : 0);
             int n = half ? nrays - nrays / 2 : nrays / 2;

@@ -4,8 +4,8 @@
  * u + r 2^e and u + s 2^e under the node's context); the decoded child
  * bounds clb (and never cub) only for children it pushes.
  *
- * cbvh_fast_pair_decode handles 64-bit nodes (N <= 6) whose decode by the
- * unit (cbvh_nodepair_decode) returns status 0: valid parameters and
+ * cbvh_fast_pair_decode handles 64-bit (N <= 6) and 96-bit (N = 7..10)
+ * nodes whose decode by the unit (cbvh_nodepair_decode) returns status 0: valid parameters and
  * contexts, no reserved bit set, empty children with zero codes, r < s on
  * every axis.  It then returns 1 with the same leaf, empty, ptr as the unit,
  * and r, s equal to cbvh_axis_store_codes(RELATIVE) of the unit's outputs
@@ -43,25 +43,37 @@ static inline uint64_t cbvh_fast_load_le64(const uint8_t *b) {
            (uint64_t)b[4] << 32 | (uint64_t)b[5] << 40 | (uint64_t)b[6] << 48 | (uint64_t)b[7] << 56;
 }
 
+static inline uint64_t cbvh_fast_load_le32(const uint8_t *b) {
+    return (uint64_t)b[0] | (uint64_t)b[1] << 8 | (uint64_t)b[2] << 16 | (uint64_t)b[3] << 24;
+}
+
+/* Node layout (nodepair_codec.c): codes in bits [0, 6N), leaf at 6N, pointer
+ * from 6N + 1, P = min(32, W - 6N - 1) bits, then reserved zeros.  For
+ * N <= 10 the codes and the leaf bit lie in the first 64 bits; a 96-bit node
+ * (N >= 7, P = 32) has its pointer's top bits and the reserved bits
+ * [6N + 33, 96) in the last 32. */
 static inline int cbvh_fast_pair_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
                                         const uint8_t *bytes, cbvh_fast_child ch[2]) {
     int n = p->quant_bits;
-    if (n < CBVH_N_MIN || n > 6 || p->min_scale < CBVH_SCALE_FLOOR || p->min_scale > CBVH_SCALE_CEIL) return 0;
+    if (n < CBVH_N_MIN || n > CBVH_N_MAX || p->min_scale < CBVH_SCALE_FLOOR || p->min_scale > CBVH_SCALE_CEIL)
+        return 0;
+    int wide = n > 6, node_bytes = wide ? 12 : 8;
     uint32_t mask = cbvh_grid_mask(p), full = mask + 1u;
     uint32_t pmod[3];
     for (int a = 0; a < 3; a++) {
         if (!cbvh_fast_ctx_ok(p, &ctx->axis[a])) return 0;
         pmod[a] = enc == CBVH_ENC_MODULO ? cbvh_fast_pmod(p, &ctx->axis[a]) : 0; /* relative: r, s = codes */
     }
-    int pp = 6 * n + 1;                     /* pointer position */
-    int pb = 64 - pp < 32 ? 64 - pp : 32;   /* pointer bits */
+    int pp = 6 * n + 1;                                 /* pointer position */
+    int pb = wide || 64 - pp >= 32 ? 32 : 64 - pp;      /* pointer bits */
     uint64_t ones = (UINT64_C(1) << pb) - 1u;
     for (int c = 0; c < 2; c++) {
-        uint64_t w = cbvh_fast_load_le64(bytes + 8 * c);
-        if (pp + pb < 64 && (w >> (pp + pb)) != 0) return 0; /* reserved bits */
+        const uint8_t *b = bytes + node_bytes * c;
+        uint64_t w = cbvh_fast_load_le64(b), x = wide ? cbvh_fast_load_le32(b + 8) : 0; /* bits 64..95 */
+        if (wide ? (x >> (pp + pb - 64)) != 0 : pp + pb < 64 && (w >> (pp + pb)) != 0) return 0; /* reserved */
         cbvh_fast_child *o = &ch[c];
         o->leaf = (int)((w >> (pp - 1)) & 1u);
-        o->ptr = (uint32_t)((w >> pp) & ones);
+        o->ptr = (uint32_t)(((w >> pp) | (wide ? x << (64 - pp) : 0)) & ones);
         o->empty = o->leaf && o->ptr == ones;
         if (o->empty) {
             if (w & ((UINT64_C(1) << (pp - 1)) - 1u)) return 0; /* codes of an empty child */

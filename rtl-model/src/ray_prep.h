@@ -53,11 +53,25 @@ uint32_t cbvh_ray_box_float_exact_only(const cbvh_ray *ray, int M, const cbvh_f3
 int cbvh_ray_box_float_fast_only(const cbvh_ray *ray, int M, const cbvh_f32 lo[3], const cbvh_f32 hi[3],
                                  cbvh_box_result *out);
 
+/* A ray prepared once for the ray-triangle unit's binary64 filter: the axis
+ * permutation and the permuted o, d as binary64 (ok: finite, d != 0). */
+typedef struct {
+    int ok, kx, ky, kz;
+    double dx, dy, dz, ox, oy, oz;
+} cbvh_tri_ray;
+void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p);
+/* cbvh_ray_triangle with the ray prepared (same outputs and status). */
+uint32_t cbvh_ray_triangle_prepared(const cbvh_tri_ray *p, const cbvh_ray *ray, const cbvh_f32 v0[3],
+                                    const cbvh_f32 v1[3], const cbvh_f32 v2[3], cbvh_tri_result *out);
+
 /* The ray-triangle unit's exact path alone, and its miss filter alone
  * (1 = proven miss; caller guarantees finite inputs and d != 0). */
 uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
                                       const cbvh_f32 v2[3], cbvh_tri_result *out);
 int cbvh_ray_triangle_filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
                                   const cbvh_f32 v2[3]);
+/* Its hit path alone: 1 = proven hit with *out = the exact path's outputs. */
+int cbvh_ray_triangle_filter_hit(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                                 cbvh_tri_result *out);
 
 #endif

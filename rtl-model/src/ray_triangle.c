@@ -98,13 +98,14 @@ uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3],
 }
 
 /* ---------------------------------------------------------------------------
- * Miss filter (docs/traversal.md, "Performance filter").  Most triangles a
+ * Filter (docs/traversal.md §9, "Performance filter").  Most triangles a
  * traversal tests are misses; the filter proves a miss in binary64 with a
  * rigorous error bound and returns the exact path's miss result (hit 0, all
- * outputs +0, status 0).  Anything it cannot prove (every hit, every
- * near-boundary case) goes to the exact path, which alone computes outputs,
- * so the unit's results stay integer-defined: the filter chooses between two
- * computations proven to give the same outputs.
+ * outputs +0, status 0).  For a certain hit it brackets t, b1, b2 and returns
+ * their binary32 truncations when both ends of each bracket agree.  Anything
+ * it cannot prove (near-zero edge functions, quotients next to a binary32)
+ * goes to the exact path, so the unit's results stay integer-defined: the
+ * filter chooses between computations proven to give the same outputs.
  *
  * Error bound: every quantity is a polynomial in the binary32 inputs, each
  * evaluated as a tree of +, -, x.  With u = 2^-53, and no underflow or
@@ -126,8 +127,35 @@ static double f32d(cbvh_f32 b) {
     return (double)f;
 }
 
-/* 1: certainly a miss; 0: undecided (the exact path decides). */
-static int filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3]) {
+/* Truncation of a positive binary64 to binary32 (round toward zero = the
+ * exact path's CBVH_RND_DOWN for a positive quotient), integer-only; 0 when
+ * x is outside the binary32 normal range (the exact path then decides). */
+static cbvh_f32 trunc_f32(double x) {
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    int e = (int)(b >> 52 & 0x7FF) - 1023;
+    if (e < -126 || e > 127 || (b >> 63)) return 0;
+    return (cbvh_f32)((uint32_t)(e + 127) << 23 | (uint32_t)((b & 0xFFFFFFFFFFFFFull) >> 29));
+}
+
+/* The binary32 truncation of the exact quotient a/b, both given as binary64
+ * approximations with relative error bounds ra, rb (|â - a| <= ra|â|, both
+ * < 2^-20, â and b̂ of one strict sign): a/b lies in q̂[1 - r, 1 + r] with
+ * r = 2(ra + rb) + 2^-48 (the 2^-48 covers the roundings of q̂ = â/b̂ and of
+ * forming the two ends, each <= 2^-53 relative); when both ends truncate to
+ * the same binary32 that is the exact result (truncation is monotone).
+ * 0: undecided. */
+static cbvh_f32 quot_trunc(double a, double b, double ra, double rb) {
+    if (!(ra < 0x1p-20 && rb < 0x1p-20)) return 0;
+    double q = a / b, r = 2.0 * (ra + rb) + 0x1p-48;
+    cbvh_f32 lo = trunc_f32(q * (1.0 - r)), hi = trunc_f32(q * (1.0 + r));
+    return lo == hi ? lo : 0;
+}
+
+void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p) {
+    int bad = 0;
+    for (int a = 0; a < 3; a++) bad |= cbvh_f32_is_nan_or_inf(ray->o[a]) | cbvh_f32_is_nan_or_inf(ray->d[a]);
+    p->ok = !bad && !(cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]));
     int kz = 0;
     for (int a = 1; a < 3; a++)
         if ((ray->d[a] & ~CBVH_F32_SIGN) > (ray->d[kz] & ~CBVH_F32_SIGN)) kz = a;
@@ -137,9 +165,26 @@ static int filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32
         kx = ky;
         ky = t;
     }
-    double dx = f32d(ray->d[kx]), dy = f32d(ray->d[ky]), dz = f32d(ray->d[kz]);
+    p->kx = kx;
+    p->ky = ky;
+    p->kz = kz;
+    p->dx = f32d(ray->d[kx]);
+    p->dy = f32d(ray->d[ky]);
+    p->dz = f32d(ray->d[kz]);
+    p->ox = f32d(ray->o[kx]);
+    p->oy = f32d(ray->o[ky]);
+    p->oz = f32d(ray->o[kz]);
+}
+
+/* 1: certainly a miss (*out = the exact path's miss); 2: certainly a hit and
+ * *out = the exact path's outputs (fill_hit only); 0: undecided (the exact
+ * path decides).  p->ok and finite vertices required. */
+static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                  int fill_hit, cbvh_tri_result *out) {
+    int kx = p->kx, ky = p->ky, kz = p->kz;
+    double dx = p->dx, dy = p->dy, dz = p->dz;
     double adx = dabs(dx), ady = dabs(dy), adz = dabs(dz);
-    double ox = f32d(ray->o[kx]), oy = f32d(ray->o[ky]), oz = f32d(ray->o[kz]);
+    double ox = p->ox, oy = p->oy, oz = p->oz;
     double aox = dabs(ox), aoy = dabs(oy), aoz = dabs(oz);
     const cbvh_f32 *v[3] = {v0, v1, v2};
     double X[3], Y[3], Z[3], AX[3], AY[3], AZ[3];
@@ -171,24 +216,64 @@ static int filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32
     double b = AT * 0x1p-47;
     int sT = T > b ? 1 : T < -b ? -1 : 0;
     int sden = sg[0] * (dz > 0 ? 1 : -1); /* d_z != 0: the largest |d| of a nonzero d */
-    return sT != 0 && sT != sden;
+    if (sT == 0) return 0;
+    if (sT != sden) return 1;
+    if (!fill_hit) return 0;
+    /* A certain hit: t = T / (det d_z), b1 = V / det, b2 = W / det, each the
+     * truncation of a positive quotient.  det = U + V + W: its terms share a
+     * strict sign, so the two additions add at most 2^-52 |det| to the
+     * 2^-48 A^ error of the terms (bound taken as 2^-47 A^); d_z is exact and
+     * det d_z adds one rounding. */
+    double det = E[0] + E[1] + E[2], adet = dabs(det);
+    double r_det = (AE[0] + AE[1] + AE[2]) * 0x1p-47 / adet;
+    double r_den = r_det + 0x1p-52, r_T = b / dabs(T);
+    cbvh_f32 t = quot_trunc(T, det * dz, r_T, r_den);
+    cbvh_f32 b1 = quot_trunc(E[1], det, AE[1] * 0x1p-48 / dabs(E[1]), r_det);
+    cbvh_f32 b2 = quot_trunc(E[2], det, AE[2] * 0x1p-48 / dabs(E[2]), r_det);
+    if (!t || !b1 || !b2) return 0;
+    memset(out, 0, sizeof *out);
+    out->hit = 1;
+    out->t = t;
+    out->b1 = b1;
+    out->b2 = b2;
+    return 2;
 }
 
-uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
-                           cbvh_tri_result *out) {
+static int verts_bad(const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3]) {
     int bad = 0;
     for (int a = 0; a < 3; a++)
-        bad |= cbvh_f32_is_nan_or_inf(ray->o[a]) | cbvh_f32_is_nan_or_inf(ray->d[a]) |
-               cbvh_f32_is_nan_or_inf(v0[a]) | cbvh_f32_is_nan_or_inf(v1[a]) | cbvh_f32_is_nan_or_inf(v2[a]);
-    if (!bad && !(cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2])) &&
-        filter_miss(ray, v0, v1, v2)) {
-        memset(out, 0, sizeof *out);
-        return 0;
+        bad |= cbvh_f32_is_nan_or_inf(v0[a]) | cbvh_f32_is_nan_or_inf(v1[a]) | cbvh_f32_is_nan_or_inf(v2[a]);
+    return bad;
+}
+
+uint32_t cbvh_ray_triangle_prepared(const cbvh_tri_ray *p, const cbvh_ray *ray, const cbvh_f32 v0[3],
+                                    const cbvh_f32 v1[3], const cbvh_f32 v2[3], cbvh_tri_result *out) {
+    if (p->ok && !verts_bad(v0, v1, v2)) {
+        int f = filter(p, v0, v1, v2, 1, out);
+        if (f == 1) memset(out, 0, sizeof *out); /* the exact path's miss */
+        if (f) return 0;
     }
     return cbvh_ray_triangle_exact_only(ray, v0, v1, v2, out);
 }
 
+uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                           cbvh_tri_result *out) {
+    cbvh_tri_ray p;
+    cbvh_tri_ray_prepare(ray, &p);
+    return cbvh_ray_triangle_prepared(&p, ray, v0, v1, v2, out);
+}
+
 int cbvh_ray_triangle_filter_miss(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
                                   const cbvh_f32 v2[3]) {
-    return filter_miss(ray, v0, v1, v2);
+    cbvh_tri_ray p;
+    cbvh_tri_result r;
+    cbvh_tri_ray_prepare(ray, &p);
+    return filter(&p, v0, v1, v2, 0, &r) == 1;
+}
+
+int cbvh_ray_triangle_filter_hit(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
+                                 cbvh_tri_result *out) {
+    cbvh_tri_ray p;
+    cbvh_tri_ray_prepare(ray, &p);
+    return filter(&p, v0, v1, v2, 1, out) == 2;
 }

@@ -41,6 +41,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     /* the ray check of trav_ray_ok, without preparing the ray */
     if (cbvh_rb_ray_status(ray, mant_bits)) return -1;
     ts.ray = ray;
+    cbvh_tri_ray_prepare(ray, &ts.tprep);
     ts.tris = tris;
     ts.mode = mode;
     ts.M = mant_bits;
@@ -49,7 +50,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     cbvh_rbf_ray fp;
     cbvh_rbf_prepare(ray, mant_bits, &fp);
     const cbvh_params *prm = &t->params;
-    int fast_codec = t->pair_bytes == 16; /* 64-bit nodes (N <= 6) */
+    int fast_codec = t->pair_bytes == cbvh_nodepair_bytes(prm->quant_bits);
 
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;

@@ -13,6 +13,7 @@
 typedef struct {
     const cbvh_ray *ray;
     cbvh_rb_ray prep; /* the ray prepared once for the box unit's fast path */
+    cbvh_tri_ray tprep; /* ... and for the triangle unit's filter (trav_prepare_tri) */
     const cbvh_tri *tris;
     cbvh_trav_mode mode;
     int M;
@@ -45,7 +46,7 @@ static inline void trav_triangle(trav_state *ts, uint32_t id) {
     trav_fetch(ts, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
     ts->s.tri_tests++;
     cbvh_tri_result r;
-    if (cbvh_ray_triangle(ts->ray, v[0], v[1], v[2], &r) || !r.hit) return;
+    if (cbvh_ray_triangle_prepared(&ts->tprep, ts->ray, v[0], v[1], v[2], &r) || !r.hit) return;
     int64_t k = cbvh_f32_key(r.t);
     if (k < cbvh_f32_key(ts->ray->tmin) || k > cbvh_f32_key(ts->ray->tmax)) return;
     if ((ts->mode & CBVH_TRAV_FRONT_ONLY) && cbvh_tri_facing(ts->ray->d, v[0], v[1], v[2]) <= 0) return;

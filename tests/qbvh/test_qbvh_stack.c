@@ -8,26 +8,13 @@
 
 #include "cbvh/qbvh.h"
 #include "cbvh/traversal_units.h"
+#include "test_util.h"
 
 static int fails;
-#define CHECK(c, ...)                                                 \
-    do {                                                              \
-        if (!(c)) {                                                   \
-            if (fails++ < 20) {                                       \
-                printf("FAIL %s:%d: ", __FILE__, __LINE__);           \
-                printf(__VA_ARGS__);                                  \
-                printf("\n");                                         \
-            }                                                         \
-        }                                                             \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(fails, stdout, c, __VA_ARGS__)
 
 static uint64_t rs = 0x1234567887654321ull;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 
 /* Reference sort: insertion sort on (missed, value of t as a double, index). */
 static double fval(uint32_t b) {

@@ -9,63 +9,12 @@
 
 #include "cbvh/qbvh.h"
 #include "scene_load.h"
+#include "test_trav_util.h"
 
 static int fails;
-#define CHECK(c, ...)                                       \
-    do {                                                    \
-        if (!(c)) {                                         \
-            if (fails++ < 20) {                             \
-                printf("FAIL %s:%d: ", __FILE__, __LINE__); \
-                printf(__VA_ARGS__);                        \
-                printf("\n");                               \
-            }                                               \
-        }                                                   \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(fails, stdout, c, __VA_ARGS__)
 
 static uint64_t rs = 0x9E3779B97F4A7C15ull;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
-static float unit(void) { return (float)((double)(rnd() >> 11) / 9007199254740992.0); }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-
-/* From outside toward the box, from inside, axis-parallel (+-0), bounded tmax. */
-static cbvh_ray make_ray(const float lo[3], const float hi[3], int i) {
-    cbvh_ray r;
-    float o[3], t[3];
-    for (int a = 0; a < 3; a++) {
-        float ext = hi[a] - lo[a] > 0 ? hi[a] - lo[a] : 1.0f;
-        float c = 0.5f * (lo[a] + hi[a]);
-        t[a] = lo[a] + unit() * (hi[a] - lo[a]);
-        o[a] = (i % 3 == 0) ? lo[a] + unit() * (hi[a] - lo[a]) : c + (unit() * 4 - 2) * ext;
-    }
-    for (int a = 0; a < 3; a++) {
-        r.o[a] = fb(o[a]);
-        r.d[a] = fb(t[a] - o[a]);
-    }
-    if (i % 7 == 0) {
-        int a = (int)(rnd() % 3);
-        for (int b = 0; b < 3; b++)
-            if (b != a) r.d[b] = (rnd() & 1) ? 0 : CBVH_F32_SIGN;
-        if (cbvh_f32_is_zero(r.d[a])) r.d[a] = fb(1.0f);
-    }
-    if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[0] = fb(1.0f);
-    r.tmin = 0;
-    r.tmax = (i % 5 == 0) ? fb(0.5f + unit()) : CBVH_F32_POS_INF;
-    return r;
-}
-
-static int same_hit(const cbvh_trav_hit *a, const cbvh_trav_hit *b) {
-    if (a->hit != b->hit) return 0;
-    return !a->hit || (a->prim == b->prim && a->t == b->t && a->b1 == b->b1 && a->b2 == b->b2);
-}
 
 static void run_scene(const char *spec, int nrays) {
     cbvh_scene s = {0};
@@ -87,7 +36,7 @@ static void run_scene(const char *spec, int nrays) {
     cbvh_trav_stats sb = {0}, sq[4] = {{0}}, sa = {0};
     int hits = 0;
     for (int i = 0; i < nrays; i++) {
-        cbvh_ray r = make_ray(lo, hi, i);
+        cbvh_ray r = box_ray(&rs, lo, hi, i, 0);
         cbvh_trav_hit hb, hq[4], ha, hqa;
         cbvh_trav_stats one[4] = {{0}};
         CHECK(cbvh_trace_bvh(&b, s.tris, &r, 24, CBVH_TRAV_CLOSEST, &hb, &sb) == 0, "bvh ray %d", i);

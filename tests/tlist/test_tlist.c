@@ -26,37 +26,14 @@
 #include "cbvh/tlist.h"
 #include "exact_wide.h"
 #include "scene_load.h"
+#include "test_trav_util.h"
 
 static long fails;
-#define CHECK(c, ...)                                       \
-    do {                                                    \
-        if (!(c)) {                                         \
-            if (fails++ < 20) {                             \
-                printf("FAIL %s:%d: ", __FILE__, __LINE__); \
-                printf(__VA_ARGS__);                        \
-                printf("\n");                               \
-            }                                               \
-        }                                                   \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(fails, stdout, c, __VA_ARGS__)
 
 static uint64_t rs = 0x243F6A8885A308D3ull;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
-static float unit(void) { return (float)((double)(rnd() >> 11) / 9007199254740992.0); }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
+static float unit(void) { return tu_unit_f(&rs); }
 
 /* ---- exact enclosure ---------------------------------------------------- */
 static int encloses(const uint32_t sph[4], const float v[3]) {
@@ -290,11 +267,6 @@ static cbvh_ray make_ray(const cbvh_scene *s, const cbvh_bsh *h, const float lo[
     r.tmin = (i % 11 == 0) ? fb(0.5f * unit()) : 0;
     r.tmax = (i % 5 == 0) ? fb(0.3f + 2 * unit()) : CBVH_F32_POS_INF;
     return r;
-}
-
-static int same_hit(const cbvh_trav_hit *a, const cbvh_trav_hit *b) {
-    if (a->hit != b->hit) return 0;
-    return !a->hit || (a->prim == b->prim && a->t == b->t && a->b1 == b->b1 && a->b2 == b->b2);
 }
 
 #define NCFG 16

@@ -24,42 +24,14 @@
 
 #include "cbvh/tlist.h"
 #include "scene_load.h"
+#include "test_trav_util.h"
 
 static long fails;
-#define CHECK(c, ...)                                       \
-    do {                                                    \
-        if (!(c)) {                                         \
-            if (fails++ < 20) {                             \
-                printf("FAIL %s:%d: ", __FILE__, __LINE__); \
-                printf(__VA_ARGS__);                        \
-                printf("\n");                               \
-            }                                               \
-        }                                                   \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(fails, stdout, c, __VA_ARGS__)
 
 static uint64_t rs = 0x13198A2E03707344ull;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
-static float unit(void) { return (float)((double)(rnd() >> 11) / 9007199254740992.0); }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-
-static int same_hit(const cbvh_trav_hit *a, const cbvh_trav_hit *b) {
-    if (a->hit != b->hit) return 0;
-    return !a->hit || (a->prim == b->prim && a->t == b->t && a->b1 == b->b1 && a->b2 == b->b2);
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
+static float unit(void) { return tu_unit_f(&rs); }
 
 static cbvh_ray mk(const float o[3], const float d[3], float tmax) {
     cbvh_ray r;

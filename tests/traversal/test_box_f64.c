@@ -6,7 +6,7 @@
  *     error-free sum (2Sum); the two-box version (cbvh_rbf_box2) equals the
  *     one-box version lane by lane;
  *   - the node-pair decode for the traversal (rtl-model/src/decode_fast.h):
- *     accepts exactly the pairs the unit decodes with status 0 (N <= 6) and
+ *     accepts exactly the pairs the unit decodes with status 0 (N = 3..10) and
  *     then gives the same leaf/empty/pointer, relative coordinates and child
  *     contexts as cbvh_nodepair_decode + cbvh_axis_child_ctx;
  *   - and the filter decides nearly all scene-like inputs (so the comparison
@@ -23,6 +23,7 @@
 #include "../../rtl-model/src/decode_fast.h"
 #include "../../rtl-model/src/ray_box_f64.h"
 #include "../../rtl-model/src/ray_prep.h"
+#include "test_util.h"
 
 #ifdef CBVH_SANITIZE
 #define NBOX 300000
@@ -34,24 +35,8 @@
 
 static long failures;
 static uint64_t rs = 0x2545F4914F6CDD1Du;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint32_t below(uint32_t n) { return (uint32_t)(rnd() % n); }
-
-static cbvh_f32 fbits(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float bfloat(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
 
 /* A binary32 pattern with exponent near emid; specials when wide. */
 static cbvh_f32 rf(int emid, int spread, int wide) {
@@ -82,10 +67,10 @@ static cbvh_f32 plane_on_grid(cbvh_f32 o, cbvh_f32 d, int M, int nudge) {
     int mb = M < 18 ? M : 18 - (int)below(3); /* bits of t: o + t d stays within 24 bits */
     double t = (double)(int)(below(1u << mb) | (1u << (mb - 1))) * (double)(1 << below(8)) / (double)(1 << 12);
     if (rnd() & 1) t = -t;
-    double p = (double)bfloat(o) + t * (double)bfloat(d);
+    double p = (double)bf(o) + t * (double)bf(d);
     float pf = (float)p;
     if (nudge) pf = nextafterf(pf, (rnd() & 1) ? 1e30f : -1e30f);
-    return fbits(pf);
+    return fb(pf);
 }
 
 /* cbvh_rbf_box2 on (box, other box) equals cbvh_rbf_box on each lane. */
@@ -124,7 +109,7 @@ static void make_ray(cbvh_ray *r, int wide, int scene, int M, int *mout) {
         r->o[a] = rf(0, wide ? 40 : 4, wide && below(4) == 0);
         r->d[a] = rdir(!scene);
     }
-    if (r->d[0] == 0 && r->d[1] == 0 && r->d[2] == 0) r->d[0] = fbits(1.0f);
+    if (r->d[0] == 0 && r->d[1] == 0 && r->d[2] == 0) r->d[0] = fb(1.0f);
     uint32_t k = below(8);
     r->tmin = k == 0 ? CBVH_F32_SIGN : k == 1 ? rf(0, 6, 0) : 0;
     k = below(8);
@@ -147,8 +132,8 @@ static void test_float_boxes(void) {
                 /* a few-bit direction and a few-bit origin: o + t d is often
                  * exact in binary32, so t lies exactly on the M-bit grid
                  * while 1/d is inexact (t^ a few ulps beside t) */
-                ray.d[a] = fbits((float)((1 + 2 * (int)below(4)) * ((rnd() & 1) ? 1 : -1)) * ldexpf(1.0f, (int)below(9) - 4));
-                ray.o[a] = fbits((float)((int)below(64) - 32) * ldexpf(1.0f, (int)below(5) - 2));
+                ray.d[a] = fb((float)((1 + 2 * (int)below(4)) * ((rnd() & 1) ? 1 : -1)) * ldexpf(1.0f, (int)below(9) - 4));
+                ray.o[a] = fb((float)((int)below(64) - 32) * ldexpf(1.0f, (int)below(5) - 2));
                 x = plane_on_grid(ray.o[a], ray.d[a], M, 0);
                 y = plane_on_grid(ray.o[a], ray.d[a], M, below(2));
             } else if (k == 1 && below(2)) {
@@ -179,13 +164,13 @@ static void test_float_boxes(void) {
         cbvh_rbf_prepare(&ray, M, &p);
         double dlo[3], dhi[3];
         for (int a = 0; a < 3; a++) {
-            dlo[a] = bfloat(lo[a]);
-            dhi[a] = bfloat(hi[a]);
+            dlo[a] = bf(lo[a]);
+            dhi[a] = bf(hi[a]);
         }
         int hit = 0;
         double tn = 0;
-        int dec = cbvh_rbf_box(&p, (double)bfloat(ray.tmax), dlo, dhi, &hit, &tn);
-        check_pair(&p, (double)bfloat(ray.tmax), dlo, dhi, dec, hit, tn, i);
+        int dec = cbvh_rbf_box(&p, (double)bf(ray.tmax), dlo, dhi, &hit, &tn);
+        check_pair(&p, (double)bf(ray.tmax), dlo, dhi, dec, hit, tn, i);
         decided += dec;
         if (!hit_ok(dec, hit, tn, st, &ex)) {
             if (failures++ < 10)
@@ -253,8 +238,8 @@ static void test_grid_boxes(void) {
             if (hard && below(64) == 0) g[a].s = g[a].r; /* inverted */
             valid &= g[a].r < g[a].s;
             if (k == 4) { /* origin on the lower plane when representable */
-                double pl = (double)bfloat(g[a].u) + (double)g[a].r * ldexp(1.0, e);
-                if ((double)(float)pl == pl) ray.o[a] = fbits((float)pl);
+                double pl = (double)bf(g[a].u) + (double)g[a].r * ldexp(1.0, e);
+                if ((double)(float)pl == pl) ray.o[a] = fb((float)pl);
             }
             ax[a] = cbvh_rbf_axis_prep(g[a].u, g[a].e);
             dlo[a] = ax[a].u + (double)g[a].r * ax[a].step;
@@ -275,8 +260,8 @@ static void test_grid_boxes(void) {
         int hit = 0;
         double tn = 0;
         /* the traversal calls the filter only for decoded boxes (r < s) */
-        int dec = valid && all_exact && cbvh_rbf_box(&p, (double)bfloat(ray.tmax), dlo, dhi, &hit, &tn);
-        if (valid && all_exact) check_pair(&p, (double)bfloat(ray.tmax), dlo, dhi, dec, hit, tn, i);
+        int dec = valid && all_exact && cbvh_rbf_box(&p, (double)bf(ray.tmax), dlo, dhi, &hit, &tn);
+        if (valid && all_exact) check_pair(&p, (double)bf(ray.tmax), dlo, dhi, dec, hit, tn, i);
         decided += dec;
         if (!hit_ok(dec, hit, tn, st, &ex)) {
             if (failures++ < 10)
@@ -326,12 +311,13 @@ static void random_ctx(const cbvh_params *p, cbvh_axis_ctx *c) {
 static void test_pair_decode(void) {
     long accepted = 0;
     for (long i = 0; i < NPAIR; i++) {
-        cbvh_params p = {3 + (int)below(4), below(4) == 0 ? -126 : -30 + (int)below(20)};
+        cbvh_params p = {3 + (int)below(8), below(4) == 0 ? -126 : -30 + (int)below(20)};
         cbvh_encoding enc = (cbvh_encoding)(rnd() & 1);
         cbvh_node_ctx ctx;
         for (int a = 0; a < 3; a++) random_ctx(&p, &ctx.axis[a]);
-        int n = p.quant_bits, pp = 6 * n + 1, pb = 64 - pp < 32 ? 64 - pp : 32;
-        uint8_t bytes[16];
+        /* nodes of W = 64 (N <= 6) or 96 bits as (w: bits 0..63, x: bits 64..95) */
+        int n = p.quant_bits, W = cbvh_node_bits(n), pp = 6 * n + 1, pb = cbvh_node_ptr_bits(n);
+        uint8_t bytes[24];
         for (int c = 0; c < 2; c++) {
             uint64_t w = rnd() & ((UINT64_C(1) << (6 * n)) - 1u);
             if (below(4)) { /* mostly valid codes: r < s on every axis */
@@ -348,10 +334,17 @@ static void test_pair_decode(void) {
             uint32_t k = below(16);
             uint64_t ones = (UINT64_C(1) << pb) - 1u;
             if (k == 0) w = 0; /* empty */
-            uint64_t ptr = k < 2 ? ones : rnd() & ones;
+            uint64_t ptr = k < 2 ? ones : rnd() & ones, x = 0;
             w |= (uint64_t)(k < 2 || (rnd() & 1)) << (pp - 1) | ptr << pp;
-            if (below(32) == 0) w |= UINT64_C(1) << (pp + below((uint32_t)(64 - pp))); /* reserved or pointer bit */
-            for (int b = 0; b < 8; b++) bytes[8 * c + b] = (uint8_t)(w >> (8 * b));
+            if (W == 96) x = ptr >> (64 - pp); /* the pointer's top bits */
+            if (below(32) == 0) { /* a reserved or pointer bit */
+                int bit = pp + (int)below((uint32_t)(W - pp));
+                if (bit < 64)
+                    w |= UINT64_C(1) << bit;
+                else
+                    x |= UINT64_C(1) << (bit - 64);
+            }
+            for (int b = 0; b < W / 8; b++) bytes[W / 8 * c + b] = (uint8_t)(b < 8 ? w >> (8 * b) : x >> (8 * (b - 8)));
         }
         cbvh_child_out ch[2];
         uint32_t st = cbvh_nodepair_decode(&p, enc, &ctx, bytes, ch);
@@ -390,7 +383,7 @@ static void test_pair_decode(void) {
             }
         }
     }
-    printf("node pairs: %d, %ld decoded with status 0 by both\n", NPAIR, accepted);
+    printf("node pairs: %d (N = 3..10), %ld decoded with status 0 by both\n", NPAIR, accepted);
     if (accepted < NPAIR / 10) {
         printf("FAIL: too few valid pairs\n");
         failures++;

@@ -184,7 +184,7 @@ static void float_box_cases(long *decided, long *total) {
     }
 }
 
-static long typ_tri_miss, typ_tri_decided;
+static long typ_tri_miss, typ_tri_decided, typ_tri_hit, typ_tri_hit_decided, tri_hit_decided;
 
 static void tri_cases(long *decided, long *total, long *exact_hits) {
     for (long i = 0; i < NTRI; i++) {
@@ -242,10 +242,75 @@ static void tri_cases(long *decided, long *total, long *exact_hits) {
             typ_tri_miss++;
             typ_tri_decided += fm;
         }
+        cbvh_tri_result rh;
+        int fh = cbvh_ray_triangle_filter_hit(&ray, v[0], v[1], v[2], &rh);
+        if (typical && re.hit) {
+            typ_tri_hit++;
+            typ_tri_hit_decided += fh;
+        }
+        if (fh) {
+            tri_hit_decided++;
+            if (se != 0 || memcmp(&re, &rh, sizeof re)) {
+                if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: hit filter's outputs != exact path's\n", i);
+            }
+        }
+        if (fm && fh) {
+            if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: filter claims both a hit and a miss\n", i);
+        }
         if (fm) {
             (*decided)++;
             if (se != 0 || re.hit) {
                 if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: filter claims a miss, exact path hits\n", i);
+            }
+        }
+    }
+}
+
+/* Rays aimed at a point inside the triangle (d = p - o in binary32): nearly
+ * every case is a hit, so the hit filter's outputs (t, b1, b2 truncated) meet
+ * the exact path's on many quotients, including t exactly 1 or a power of two
+ * (d scaled by 2^k) where the filter must leave the decision to the exact path. */
+static void tri_hit_cases(long *hits, long *decided, long *on_grid) {
+    for (long i = 0; i < NTRI; i++) {
+        typical = 1;
+        int emid = below(8) == 0 ? (int)below(160) - 80 : small_exp();
+        cbvh_ray ray = random_ray(emid, 2);
+        cbvh_f32 v[3][3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++) v[k][a] = rf(emid, 2);
+        float w1 = (float)(below(1000) + 1) / 1024.0f, w2 = (float)(below(1000) + 1) / 1024.0f;
+        if (w1 + w2 >= 1.0f) w1 = 1.0f - w1, w2 = 1.0f - w2;
+        int k2 = (int)below(9) - 4;
+        float scale = k2 >= 0 ? (float)(1u << k2) : 1.0f / (float)(1u << -k2);
+        for (int a = 0; a < 3; a++) {
+            float p0, p1, p2, o;
+            memcpy(&p0, &v[0][a], 4);
+            memcpy(&p1, &v[1][a], 4);
+            memcpy(&p2, &v[2][a], 4);
+            memcpy(&o, &ray.o[a], 4);
+            float p = p0 + w1 * (p1 - p0) + w2 * (p2 - p0);
+            float dd = (p - o) * scale;
+            memcpy(&ray.d[a], &dd, 4);
+        }
+        ray.tmin = 0;
+        ray.tmax = CBVH_F32_POS_INF;
+        int bad = 0;
+        for (int a = 0; a < 3; a++)
+            bad |= cbvh_f32_is_nan_or_inf(ray.d[a]) | cbvh_f32_is_nan_or_inf(ray.o[a]);
+        if (bad || (cbvh_f32_is_zero(ray.d[0]) && cbvh_f32_is_zero(ray.d[1]) && cbvh_f32_is_zero(ray.d[2])))
+            continue;
+        cbvh_tri_result re, ru, rh;
+        uint32_t se = cbvh_ray_triangle_exact_only(&ray, v[0], v[1], v[2], &re);
+        uint32_t su = cbvh_ray_triangle(&ray, v[0], v[1], v[2], &ru);
+        if (se != su || memcmp(&re, &ru, sizeof re)) {
+            if (failures++ < 10) fprintf(stderr, "FAIL tri hit %ld: unit != exact\n", i);
+        }
+        *hits += re.hit;
+        if (re.hit && (re.t & CBVH_F32_FRAC) == 0) (*on_grid)++;
+        if (cbvh_ray_triangle_filter_hit(&ray, v[0], v[1], v[2], &rh)) {
+            (*decided)++;
+            if (se != 0 || memcmp(&re, &rh, sizeof re)) {
+                if (failures++ < 10) fprintf(stderr, "FAIL tri hit %ld: hit filter's outputs != exact path's\n", i);
             }
         }
     }
@@ -256,16 +321,25 @@ int main(void) {
     box_cases(&bd, &bt);
     float_box_cases(&fd, &ft);
     tri_cases(&td, &tt, &th);
+    long hh = 0, hd = 0, hg = 0;
+    tri_hit_cases(&hh, &hd, &hg);
+    printf("ray_triangle aimed rays: %d rays, %ld exact hits (%ld with t truncated to a power of two), hit filter decided %ld "
+           "(%.2f%%)\n",
+           NTRI, hh, hg, hd, 100.0 * (double)hd / (double)(hh ? hh : 1));
     printf("ray_box grid: %ld inputs, fast path decided %ld (%.2f%%)\n", bt, bd, 100.0 * (double)bd / (double)bt);
     printf("ray_box float: %ld inputs, fast path decided %ld (%.2f%%)\n", ft, fd, 100.0 * (double)fd / (double)ft);
     printf("ray_triangle: %ld inputs (%ld exact hits), filter proved %ld misses (%.2f%% of the %ld misses)\n", tt, th,
            td, 100.0 * (double)td / (double)(tt - th), tt - th);
+    printf("ray_triangle: hit filter decided %ld of the %ld exact hits; scene-like: %ld of %ld (%.2f%%)\n",
+           tri_hit_decided, th, typ_tri_hit_decided, typ_tri_hit,
+           100.0 * (double)typ_tri_hit_decided / (double)(typ_tri_hit ? typ_tri_hit : 1));
     printf("scene-like inputs: box fast path decided %.3f%% of %ld, triangle filter proved %.3f%% of %ld misses\n",
            100.0 * (double)typ_decided / (double)typ_total, typ_total,
            100.0 * (double)typ_tri_decided / (double)typ_tri_miss, typ_tri_miss);
     /* the fast paths must carry the bulk of the work, or the speed-up is fake */
     if (typ_decided < typ_total * 99 / 100 || typ_tri_decided < typ_tri_miss * 9 / 10 || bd == 0 || fd == 0 ||
-        td == 0) {
+        td == 0 || typ_tri_hit == 0 || typ_tri_hit_decided < typ_tri_hit * 9 / 10 ||
+        hh < NTRI / 2 || hd < hh / 2) {
         fprintf(stderr, "FAIL: fast paths decide too few cases\n");
         failures++;
     }

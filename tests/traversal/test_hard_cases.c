@@ -17,6 +17,7 @@
 
 #include "cbvh/traverse.h"
 #include "cbvh/unit_table.h"
+#include "test_trav_util.h"
 
 #ifdef CBVH_SANITIZE
 #define SCALE_DOWN 10
@@ -36,23 +37,8 @@ static long failures;
 
 /* ---- small helpers ------------------------------------------------------ */
 static uint64_t rs = 0x9E3779B97F4A7C15u;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
-static double unit(void) { return (double)(rnd() >> 11) / 9007199254740992.0; }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
+static double unit(void) { return tu_unit_d(&rs); }
 static cbvh_f32 zero_bits(void) { return (rnd() & 1) ? 0u : CBVH_F32_SIGN; } /* +0 or -0 */
 
 static cbvh_ray make_ray(const float o[3], const float d[3]) {
@@ -311,29 +297,6 @@ static void world_free(world *w) {
     cbvh_scene_free(&w->s);
 }
 
-static cbvh_trav_hit brute(const cbvh_scene *s, const cbvh_ray *r) {
-    cbvh_trav_hit best = {0};
-    for (uint32_t i = 0; i < s->ntris; i++) {
-        cbvh_f32 v[3][3];
-        memcpy(v, s->tris[i].v, sizeof v);
-        cbvh_tri_result res;
-        if (cbvh_ray_triangle(r, v[0], v[1], v[2], &res) || !res.hit) continue;
-        int64_t k = cbvh_f32_key(res.t);
-        if (k < cbvh_f32_key(r->tmin) || k > cbvh_f32_key(r->tmax)) continue;
-        if (best.hit && k >= cbvh_f32_key(best.t)) continue; /* ascending ids: first wins ties */
-        best.hit = 1;
-        best.prim = i;
-        best.t = res.t;
-        best.b1 = res.b1;
-        best.b2 = res.b2;
-    }
-    return best;
-}
-
-static int same(const cbvh_trav_hit *a, const cbvh_trav_hit *b) {
-    return a->hit == b->hit && (!a->hit || (a->prim == b->prim && a->t == b->t && a->b1 == b->b1 && a->b2 == b->b2));
-}
-
 /* An any-hit result must be a real hit of the unit in [tmin, tmax]. */
 static int any_ok(const world *w, const cbvh_ray *r, const cbvh_trav_hit *any, int ref_hit) {
     if (any->hit != ref_hit) return 0;
@@ -363,7 +326,7 @@ static cbvh_trav_hit check_ray(world *w, const cbvh_ray *r, int use_brute) {
         }
         if (!use_brute && bi == 0) ref = h;
         w->checks++;
-        if (!same(&h, &ref)) {
+        if (!same_hit(&h, &ref)) {
             FAIL("float BVH %s closest hit %d prim %u t %08X != %s hit %d prim %u t %08X", w->bname[bi], h.hit, h.prim,
                  h.t, use_brute ? "brute force" : "float BVH", ref.hit, ref.prim, ref.t);
             print_ray("", r);
@@ -382,7 +345,7 @@ static cbvh_trav_hit check_ray(world *w, const cbvh_ray *r, int use_brute) {
             continue;
         }
         w->checks++;
-        if (!same(&h, &ref)) {
+        if (!same_hit(&h, &ref)) {
             FAIL("CBVH %s closest hit %d prim %u t %08X != reference hit %d prim %u t %08X", tc->name, h.hit, h.prim,
                  h.t, ref.hit, ref.prim, ref.t);
             print_ray("", r);

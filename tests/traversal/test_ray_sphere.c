@@ -20,6 +20,7 @@
 
 #include "cbvh/traversal_units.h"
 #include "ray_sphere_internal.h"
+#include "test_util.h"
 
 #ifdef CBVH_SANITIZE
 #define N_ORACLE 120000
@@ -34,24 +35,10 @@
 #define F_INF CBVH_F32_POS_INF
 
 static long failures;
-#define CHECK(cond, ...)                                                                                             \
-    do {                                                                                                             \
-        if (!(cond)) {                                                                                               \
-            if (failures++ < 20) {                                                                                   \
-                fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                                 \
-                fprintf(stderr, __VA_ARGS__);                                                                        \
-                fprintf(stderr, "\n");                                                                               \
-            }                                                                                                        \
-        }                                                                                                            \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(failures, stderr, c, __VA_ARGS__)
 
 static uint64_t rs = 0x5DEECE66D2545F49u;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint64_t below(uint64_t n) { return rnd() % n; }
 static int64_t range(int64_t lo, int64_t hi) { return lo + (int64_t)below((uint64_t)(hi - lo + 1)); }
 
@@ -267,18 +254,13 @@ static void gen_random(scase *s) {
  * relative to the absolute-value tree; test_bound checks the bound itself.) */
 
 static float qd_to_f(const mpq_t q) { return (float)mpq_get_d(q); }
-static cbvh_f32 fbits(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
 /* A full-width significand at exponent e (normal range). */
 static cbvh_f32 wide(int sign, int e) { return mkf(sign, e, (uint32_t)rnd() | 1u); }
 /* binary32 nearest to sqrt(q) (q >= 0, within range), then a few ulps either way. */
 static cbvh_f32 sqrt_near(const mpq_t q) {
     double v = mpq_get_d(q);
     float f = (float)sqrt(v);
-    cbvh_f32 b = fbits(f) & ~CBVH_F32_SIGN;
+    cbvh_f32 b = fb(f) & ~CBVH_F32_SIGN;
     for (int k = (int)below(3); k > 0 && !cbvh_f32_is_nan_or_inf(b); k--) b = nudge(b) & ~CBVH_F32_SIGN;
     return cbvh_f32_is_nan_or_inf(b) ? CBVH_F32_MAX : b;
 }
@@ -332,14 +314,14 @@ static void gen_deep(scase *s) {
             q_f32(t, s->ray.o[k]);
             mpq_sub(q, q, t);
             float f = qd_to_f(q);
-            s->ray.d[k] = fbits(f);
+            s->ray.d[k] = fb(f);
             if (below(4) == 0) s->ray.d[k] = nudge(s->ray.d[k]);
         }
         q_tstar(t, s);
         q_f_at(q, s, t);
         s->r = sqrt_near(q);
         random_t(s);
-        if (below(2)) s->ray.tmin = fbits(qd_to_f(t)), s->ray.tmax = F_INF;
+        if (below(2)) s->ray.tmin = fb(qd_to_f(t)), s->ray.tmax = F_INF;
     } else { /* t* (nearly) at tmin or tmax, r about the distance there */
         for (int k = 0; k < 3; k++) s->ray.d[k] = wide((int)below(2), ed + (int)range(-3, 3));
         if (below(2)) { /* d nearly perpendicular to w = c - o: B = w . d cancels, t* near 0 */
@@ -358,12 +340,12 @@ static void gen_deep(scase *s) {
                 v[k] = w[i] * u[j] - w[j] * u[i];
                 m = v[k] > m ? v[k] : -v[k] > m ? -v[k] : m;
             }
-            for (int k = 0; k < 3; k++) s->ray.d[k] = m > 0 ? fbits((float)(v[k] / m * 0x1p20)) : F_ONE;
+            for (int k = 0; k < 3; k++) s->ray.d[k] = m > 0 ? fb((float)(v[k] / m * 0x1p20)) : F_ONE;
             if (cbvh_f32_is_zero(s->ray.d[0]) && cbvh_f32_is_zero(s->ray.d[1]) && cbvh_f32_is_zero(s->ray.d[2]))
                 s->ray.d[0] = F_ONE;
         }
         q_tstar(t, s);
-        cbvh_f32 tb = fbits(qd_to_f(t));
+        cbvh_f32 tb = fb(qd_to_f(t));
         if (below(2)) tb = nudge(tb);
         if (cbvh_f32_is_nan_or_inf(tb)) tb = 0;
         if (kind == 1) s->ray.tmin = tb, s->ray.tmax = below(2) ? F_INF : nudge(nudge(tb));

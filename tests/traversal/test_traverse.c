@@ -15,6 +15,7 @@
 #include "cbvh/traverse.h"
 #include "cbvh/unit_table.h"
 #include "scene_load.h"
+#include "test_trav_util.h"
 
 #ifdef CBVH_SANITIZE
 #define RAYS 300
@@ -26,73 +27,6 @@
 
 static long failures;
 static uint64_t rs = 0xD1B54A32D192ED03u;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
-static float unit(void) { return (float)((double)(rnd() >> 11) / 9007199254740992.0); }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-
-/* Rays: from outside the scene box toward a point inside it, from inside the
- * box, axis-parallel ones (+0/-0 components), and (cloth) edge-on rays in the
- * plane of the cloth. */
-static cbvh_ray make_ray(const float lo[3], const float hi[3], int i, int edge_on) {
-    cbvh_ray r;
-    float o[3], t[3];
-    for (int a = 0; a < 3; a++) {
-        float ext = hi[a] - lo[a] > 0 ? hi[a] - lo[a] : 1.0f;
-        float c = 0.5f * (lo[a] + hi[a]);
-        t[a] = lo[a] + unit() * (hi[a] - lo[a]);
-        o[a] = (i % 3 == 0) ? lo[a] + unit() * (hi[a] - lo[a]) : c + (unit() * 4 - 2) * ext;
-    }
-    if (edge_on && i % 4 == 1) { /* in the cloth's plane z = lo (= hi away from the bump) */
-        o[2] = lo[2];
-        t[2] = lo[2];
-    }
-    for (int a = 0; a < 3; a++) {
-        r.o[a] = fb(o[a]);
-        r.d[a] = fb(t[a] - o[a]);
-    }
-    if (i % 7 == 0) { /* axis-parallel */
-        int a = (int)(rnd() % 3);
-        for (int b = 0; b < 3; b++)
-            if (b != a) r.d[b] = (rnd() & 1) ? 0 : CBVH_F32_SIGN;
-        if (cbvh_f32_is_zero(r.d[a])) r.d[a] = fb(1.0f);
-    }
-    if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[0] = fb(1.0f);
-    r.tmin = 0;
-    r.tmax = (i % 5 == 0) ? fb(0.5f + unit()) : CBVH_F32_POS_INF;
-    return r;
-}
-
-static cbvh_trav_hit brute(const cbvh_scene *s, const cbvh_ray *r) {
-    cbvh_trav_hit best = {0};
-    for (uint32_t i = 0; i < s->ntris; i++) {
-        cbvh_f32 v[3][3];
-        memcpy(v, s->tris[i].v, sizeof v);
-        cbvh_tri_result res;
-        if (cbvh_ray_triangle(r, v[0], v[1], v[2], &res) || !res.hit) continue;
-        int64_t k = cbvh_f32_key(res.t);
-        if (k < cbvh_f32_key(r->tmin) || k > cbvh_f32_key(r->tmax)) continue;
-        if (best.hit && k >= cbvh_f32_key(best.t)) continue; /* ascending ids: first wins ties */
-        best.hit = 1;
-        best.prim = i;
-        best.t = res.t;
-        best.b1 = res.b1;
-        best.b2 = res.b2;
-    }
-    return best;
-}
-
-static int same(const cbvh_trav_hit *a, const cbvh_trav_hit *b) {
-    return a->hit == b->hit && (!a->hit || (a->prim == b->prim && a->t == b->t && a->b1 == b->b1 && a->b2 == b->b2));
-}
 
 static void run_scene(const char *spec) {
     cbvh_scene s;
@@ -117,7 +51,7 @@ static void run_scene(const char *spec) {
     cbvh_trav_stats fs = {0}, fa = {0};
     long hits = 0;
     for (int i = 0; i < RAYS; i++) {
-        rays[i] = make_ray(lo, hi, i, edge_on);
+        rays[i] = box_ray(&rs, lo, hi, i, edge_on);
         cbvh_trav_hit any;
         if (cbvh_trace_bvh(&b, s.tris, &rays[i], 24, CBVH_TRAV_CLOSEST, &ref[i], &fs) ||
             cbvh_trace_bvh(&b, s.tris, &rays[i], 24, CBVH_TRAV_ANY, &any, &fa)) {
@@ -128,7 +62,7 @@ static void run_scene(const char *spec) {
         if (any.hit != ref[i].hit) failures++;
         if (i < BRUTE) {
             cbvh_trav_hit bf = brute(&s, &rays[i]);
-            if (!same(&bf, &ref[i])) {
+            if (!same_hit(&bf, &ref[i])) {
                 if (failures++ < 10) fprintf(stderr, "FAIL %s ray %d: float BVH != brute force\n", spec, i);
             }
         }
@@ -160,7 +94,7 @@ static void run_scene(const char *spec) {
                 failures++;
                 continue;
             }
-            if (!same(&h, &ref[i])) {
+            if (!same_hit(&h, &ref[i])) {
                 if (mismatches++ < 3)
                     fprintf(stderr, "FAIL %s N=%d M=%d ray %d: CBVH hit %d prim %u t %08X, float %d prim %u t %08X\n",
                             spec, cfg[c].N, cfg[c].M, i, h.hit, h.prim, h.t, ref[i].hit, ref[i].prim, ref[i].t);

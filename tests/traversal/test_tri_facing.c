@@ -11,6 +11,7 @@
 #include "cbvh/bvh.h"
 #include "cbvh/traversal_units.h"
 #include "cbvh/traverse.h"
+#include "test_util.h"
 
 #ifdef CBVH_SANITIZE
 #define N_RANDOM 60000
@@ -21,29 +22,10 @@
 #endif
 
 static int failures;
-#define CHECK(c, ...)                                                                                                  \
-    do {                                                                                                               \
-        if (!(c)) {                                                                                                    \
-            if (failures++ < 20) {                                                                                     \
-                fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                                   \
-                fprintf(stderr, __VA_ARGS__);                                                                          \
-                fprintf(stderr, "\n");                                                                                 \
-            }                                                                                                          \
-        }                                                                                                              \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(failures, stderr, c, __VA_ARGS__)
 
 static uint64_t rng_s = 0x1234567887654321u;
-static uint64_t rnd64(void) {
-    rng_s ^= rng_s << 13;
-    rng_s ^= rng_s >> 7;
-    rng_s ^= rng_s << 17;
-    return rng_s;
-}
-static cbvh_f32 bits_of(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
+static uint64_t rnd64(void) { return tu_xorshift64(&rng_s); }
 
 /* A finite binary32 with a random exponent in [emin, emax] (or 0). */
 static cbvh_f32 rnd_f32(int emin, int emax) {
@@ -100,12 +82,12 @@ static void predicate_tests(void) {
     float V[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     cbvh_f32 v[3][3];
     for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++) v[i][k] = bits_of(V[i][k]);
-    cbvh_f32 down[3] = {0, 0, bits_of(-1.0f)}, up[3] = {0, 0, bits_of(1.0f)}, side[3] = {bits_of(1.0f), 0, 0};
+        for (int k = 0; k < 3; k++) v[i][k] = fb(V[i][k]);
+    cbvh_f32 down[3] = {0, 0, fb(-1.0f)}, up[3] = {0, 0, fb(1.0f)}, side[3] = {fb(1.0f), 0, 0};
     CHECK(cbvh_tri_facing(down, v[0], v[1], v[2]) == 1, "ccw seen from +z is the front");
     CHECK(cbvh_tri_facing(up, v[0], v[1], v[2]) == -1, "from below is the back");
     CHECK(cbvh_tri_facing(side, v[0], v[1], v[2]) == 0, "edge-on");
-    cbvh_f32 col[3] = {bits_of(2.0f), 0, 0}; /* degenerate: collinear */
+    cbvh_f32 col[3] = {fb(2.0f), 0, 0}; /* degenerate: collinear */
     CHECK(cbvh_tri_facing(down, v[0], v[1], col) == 0, "degenerate");
     long n = 0;
     for (; n < N_RANDOM; n++) {
@@ -128,9 +110,9 @@ static void predicate_tests(void) {
             for (int k = 0; k < 3; k++) c[k] = b[k] + (rnd64() & 1);
         if (kind == 4) /* shared tiny/huge mix: far-from-origin sliver */
             for (int k = 0; k < 3; k++) {
-                a[k] = bits_of(1e6f) + (cbvh_f32)(rnd64() & 7);
-                b[k] = bits_of(1e6f) + (cbvh_f32)(rnd64() & 7);
-                c[k] = bits_of(1e6f) + (cbvh_f32)(rnd64() & 7);
+                a[k] = fb(1e6f) + (cbvh_f32)(rnd64() & 7);
+                b[k] = fb(1e6f) + (cbvh_f32)(rnd64() & 7);
+                c[k] = fb(1e6f) + (cbvh_f32)(rnd64() & 7);
             }
         one(d, a, b, c);
     }
@@ -163,10 +145,10 @@ static void one_sided_traversal(void) {
     for (int r = 0; r < N_RAYS; r++) {
         cbvh_ray ray;
         for (int k = 0; k < 3; k++) {
-            ray.o[k] = bits_of((float)(rnd64() % 1200) / 100.0f - 1.0f);
-            ray.d[k] = bits_of((float)((int)(rnd64() % 2001) - 1000) / 1000.0f);
+            ray.o[k] = fb((float)(rnd64() % 1200) / 100.0f - 1.0f);
+            ray.d[k] = fb((float)((int)(rnd64() % 2001) - 1000) / 1000.0f);
         }
-        if (!ray.d[0] && !ray.d[1] && !ray.d[2]) ray.d[0] = bits_of(1.0f);
+        if (!ray.d[0] && !ray.d[1] && !ray.d[2]) ray.d[0] = fb(1.0f);
         ray.tmin = 0;
         ray.tmax = CBVH_F32_POS_INF;
         for (int any = 0; any < 2; any++) {

@@ -1,0 +1,50 @@
+/* The prelude the tests share: a CHECK-style failure report, the xorshift64
+ * generator and binary32 bit helpers.  Header-only (macros, static inline), so
+ * each test keeps its own counter, stream and generator state and seed. */
+#ifndef CBVH_TEST_UTIL_H
+#define CBVH_TEST_UTIL_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cbvh/fp32.h"
+
+/* Count a failed `cond` in `counter`; print the first 20 to `stream` as
+ * "FAIL file:line: <message>".  A test wraps it as its CHECK:
+ *   #define CHECK(c, ...) TU_CHECK(fails, stdout, c, __VA_ARGS__) */
+#define TU_CHECK(counter, stream, cond, ...)                                                                           \
+    do {                                                                                                               \
+        if (!(cond)) {                                                                                                 \
+            if ((counter)++ < 20) {                                                                                    \
+                fprintf(stream, "FAIL %s:%d: ", __FILE__, __LINE__);                                                   \
+                fprintf(stream, __VA_ARGS__);                                                                          \
+                fprintf(stream, "\n");                                                                                 \
+            }                                                                                                          \
+        }                                                                                                              \
+    } while (0)
+
+/* xorshift64 (13, 7, 17) on the caller's state; the seed picks the sequence. */
+static inline uint64_t tu_xorshift64(uint64_t *s) {
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    return *s;
+}
+/* Uniform in [0, 1) from the top 53 bits, as a double and rounded to float. */
+static inline double tu_unit_d(uint64_t *s) { return (double)(tu_xorshift64(s) >> 11) / 9007199254740992.0; }
+static inline float tu_unit_f(uint64_t *s) { return (float)tu_unit_d(s); }
+
+/* binary32 bit pattern of a float, and back. */
+static inline cbvh_f32 fb(float f) {
+    cbvh_f32 b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+static inline float bf(cbvh_f32 b) {
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+#endif
