@@ -11,13 +11,17 @@
  * to reach a split completes its parent.  It yields the same tree as Karras'
  * top-down search over the distinct codes, and the same node numbering: an
  * inner node is numbered by its range end that touches its parent's split
- * (hi for a left child, lo for a right child), the root is 0. */
+ * (hi for a left child, lo for a right child), the root is 0.
+ *
+ * The two phases (leaves; hierarchy and boxes) are shared with the fused
+ * builder build_lbvh_streaming.c through lbvh_internal.h, which holds the
+ * hierarchy pass. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "cbvh/bvh.h"
+#include "lbvh_internal.h"
 
 /* Spread the low 10 bits of x to every third bit. */
 static inline uint32_t spread3(uint32_t x) {
@@ -62,13 +66,6 @@ static uint64_t *radix_sort(uint64_t *a, uint64_t *tmp, uint32_t n, uint32_t his
     return a;
 }
 
-static inline void merge_box(cbvh_bvh_node *p, const cbvh_bvh_node *a, const cbvh_bvh_node *b) {
-    for (int x = 0; x < 3; x++) {
-        p->lo[x] = a->lo[x] < b->lo[x] ? a->lo[x] : b->lo[x];
-        p->hi[x] = a->hi[x] > b->hi[x] ? a->hi[x] : b->hi[x];
-    }
-}
-
 /* Centre of a triangle's box, without overflow for coordinates up to FLT_MAX. */
 static inline void tri_centre(const cbvh_tri *t, float c[3]) {
     float lo[3], hi[3];
@@ -76,8 +73,8 @@ static inline void tri_centre(const cbvh_tri *t, float c[3]) {
     for (int a = 0; a < 3; a++) c[a] = 0.5f * lo[a] + 0.5f * hi[a];
 }
 
-int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen) {
-    memset(out, 0, sizeof *out);
+int cbvh_lbvh_leaves(const cbvh_scene *s, cbvh_lbvh_work *w, int with_ids, char *err, size_t errlen) {
+    memset(w, 0, sizeof *w);
     /* The full validation runs up front only for what the fast vertex scan
      * below cannot see, and afterwards to word the error when it finds a
      * non-finite vertex (same message either way). */
@@ -152,9 +149,10 @@ int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen
         tmp = t;
     }
 
-    /* Distinct codes (into tmp), then the leaves in Morton order with their
-     * boxes. */
-    uint32_t *codes = (uint32_t *)tmp;
+    /* Distinct codes (into the upper half of tmp), then the leaves in Morton
+     * order with their boxes (and the IDs into the lower half: pages the sort
+     * has touched already). */
+    uint32_t *codes = (uint32_t *)tmp + n, *ids = with_ids ? (uint32_t *)tmp : NULL;
     uint32_t m = 0;
     for (uint32_t i = 0; i < n; i++) {
         uint32_t c = (uint32_t)(keys[i] >> 32);
@@ -169,7 +167,9 @@ int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen
         float lo[3], hi[3];
         cbvh_tri_bounds(&s->tris[t], lo, hi);
         prims[i] = t;
+        if (ids) ids[i] = t;
         if (i == 0 || code != c) {
+            if (ids && i) ids[i - 1] |= CBVH_ID_LAST; /* the previous leaf's last ID */
             c = code;
             lf = lf ? lf + 1 : &nodes[L];
             lf->child[0] = lf->child[1] = 0;
@@ -185,53 +185,35 @@ int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen
             if (hi[a] > lf->hi[a]) lf->hi[a] = hi[a];
         }
     }
-    uint32_t *split = (uint32_t *)keys; /* keys are dead: 8n >= 8(m-1) bytes */
+    if (ids) ids[n - 1] |= CBVH_ID_LAST;
+    w->nodes = nodes;
+    w->prims = prims;
+    w->ids = ids;
+    w->codes = codes;
+    w->split = (uint32_t *)keys; /* keys are dead: 8n >= 8(m-1) bytes */
+    w->buf[0] = keys;
+    w->buf[1] = tmp;
+    w->n = n;
+    w->m = m;
+    return 0;
+}
 
-    /* Hierarchy and boxes bottom-up (see the top comment).  split[2g] and
-     * split[2g+1]: the far range end and node index of the first child to
-     * reach split g (between leaves g and g+1); UINT32_MAX = none yet. */
-    for (uint32_t g = 0; g + 1 < m; g++) split[2 * g] = UINT32_MAX;
-    for (uint32_t i = 0; m > 1 && i < m; i++) {
-        uint32_t lo = i, hi = i, x = L + i;
-        for (;;) {
-            if (lo == 0 && hi == m - 1) break; /* the root (node 0) is done */
-            int left = lo == 0 || (hi != m - 1 && (codes[hi] ^ codes[hi + 1]) < (codes[lo - 1] ^ codes[lo]));
-            uint32_t g = left ? hi : lo - 1;
-            if (split[2 * g] == UINT32_MAX) { /* the sibling is not done yet */
-                split[2 * g] = left ? lo : hi;
-                split[2 * g + 1] = x;
-                break;
-            }
-            uint32_t other = split[2 * g + 1];
-            uint32_t lc = left ? x : other, rc = left ? other : x;
-            if (left)
-                hi = split[2 * g];
-            else
-                lo = split[2 * g];
-            /* The parent's number: 0 for the root, else its end touching its
-             * own parent's split. */
-            uint32_t p;
-            if (lo == 0 && hi == m - 1)
-                p = 0;
-            else if (lo == 0 || (hi != m - 1 && (codes[hi] ^ codes[hi + 1]) < (codes[lo - 1] ^ codes[lo])))
-                p = hi;
-            else
-                p = lo;
-            cbvh_bvh_node *pn = &nodes[p];
-            pn->child[0] = lc;
-            pn->child[1] = rc;
-            pn->first = 0;
-            pn->count = 0;
-            merge_box(pn, &nodes[lc], &nodes[rc]);
-            x = p;
-        }
-    }
-    free(keys);
-    free(tmp);
-    out->nodes = nodes;
-    out->nnodes = nn;
+void cbvh_lbvh_finish(cbvh_lbvh_work *w, cbvh_bvh *out) {
+    free(w->buf[0]);
+    free(w->buf[1]);
+    out->nodes = w->nodes;
+    out->nnodes = 2 * w->m - 1;
     out->root = 0; /* with m == 1 the single leaf is node 0 */
-    out->prims = prims;
-    out->nprims = n;
+    out->prims = w->prims;
+    out->nprims = w->n;
+    memset(w, 0, sizeof *w);
+}
+
+int cbvh_build_lbvh(const cbvh_scene *s, cbvh_bvh *out, char *err, size_t errlen) {
+    memset(out, 0, sizeof *out);
+    cbvh_lbvh_work w;
+    if (cbvh_lbvh_leaves(s, &w, 0, err, errlen)) return -1;
+    cbvh_lbvh_hierarchy(&w, NULL, NULL);
+    cbvh_lbvh_finish(&w, out);
     return 0;
 }

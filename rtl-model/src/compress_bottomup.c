@@ -46,11 +46,16 @@
  * - Leaves are emitted without a walk step of their own.
  * Every input outside these cases (grid coordinates beyond 64 bits, a
  * rejected or non-fitting box, a leaf root, a malformed tree) takes the
- * general path, which calls the units exactly as specified. */
+ * general path, which calls the units exactly as specified.
+ *
+ * The per-node step (bu_step) is also the fused LBVH builder's
+ * (build_lbvh_streaming.c, through bu_stream.h): the walk below only finds
+ * the post-order, assigns slots and writes IDs. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bu_stream.h"
 #include "cbvh_layout.h"
 #include "grid.h"
 #include "unit_fast.h"
@@ -297,6 +302,152 @@ static inline int inner_codes(const cbvh_params *p, int n, int ms, const bu_rec 
     return bad;
 }
 
+struct cbvh_bu_stream {
+    bu_state bt; /* options, output, statistics, backtracking stack, err */
+    bu_rec *recs; /* the context stack */
+    uint32_t sp;
+};
+
+cbvh_bu_stream *cbvh_bu_open(const cbvh_compress_opts *o, cbvh_tree *t, cbvh_bu_stats *st, uint32_t npairs,
+                             char *err, size_t errlen) {
+    cbvh_bu_stream *s = malloc(sizeof *s);
+    if (!s) abort();
+    s->bt = (bu_state){o, t, st, malloc(((size_t)npairs + 2) * sizeof(bt_item)), err, errlen};
+    s->recs = malloc(((size_t)npairs + 1) * sizeof *s->recs);
+    s->sp = 0;
+    if (!s->bt.stack || !s->recs) abort();
+    return s;
+}
+
+void cbvh_bu_close(cbvh_bu_stream *s) {
+    if (!s) return;
+    free(s->bt.stack);
+    free(s->recs);
+    free(s);
+}
+
+/* Node-pair input for a float node with slot `slot`. */
+static void child_in(const cbvh_bvh_node *n, uint32_t slot, cbvh_child_in *in) {
+    for (int a = 0; a < 3; a++) in->lo[a] = cbvh_f32_of(n->lo[a]), in->hi[a] = cbvh_f32_of(n->hi[a]);
+    in->leaf = cbvh_bvh_is_leaf(n);
+    in->empty = 0;
+    in->ptr = slot;
+}
+
+/* The step of Algorithm 1 for node n into pair `pair`: an inner node with
+ * children cn[0], cn[1] (slots slot[0], slot[1]; their records, if inner, on
+ * top of the context stack), or with cn == NULL a leaf root (slot[0] its
+ * first ID).  Its record is pushed.  0 or -1 + reason. */
+static inline int bu_step(cbvh_bu_stream *bs, const cbvh_bvh_node *n, const cbvh_bvh_node *const cn_in[2],
+                          const uint32_t slot[2], uint32_t pair) {
+    bu_state *s = &bs->bt;
+    const cbvh_compress_opts *o = s->o;
+    cbvh_bu_stats *stats = s->st;
+    bu_rec *recs = bs->recs;
+    /* cbvh_tree_init has checked the parameters and that every pointer fits
+     * its field, so the fast path packs codes without the encoder's checks. */
+    const cbvh_params *p = &o->params;
+    const int nq = p->quant_bits, msc = p->min_scale, rel = o->enc == CBVH_ENC_RELATIVE;
+    const uint32_t qmask = (1u << nq) - 1u;
+    const size_t pbytes = s->t->pair_bytes, nbytes = pbytes / 2;
+    uint32_t sp = bs->sp;
+    int leaf = cn_in == NULL;
+    uint8_t *bytes = s->t->pairs + (size_t)pair * pbytes;
+
+    /* ---- fast path: an inner node whose boxes all take the integer steps */
+    if (!leaf) {
+        bu_rec rx;
+        const cbvh_bvh_node *cn[2] = {cn_in[0], cn_in[1]};
+        int cleaf[2] = {cbvh_bvh_is_leaf(cn[0]), cbvh_bvh_is_leaf(cn[1])};
+        /* the children's records: child 1's on top */
+        const bu_rec *cr[2] = {NULL, NULL};
+        uint32_t inner_children = (uint32_t)(!cleaf[0] + !cleaf[1]);
+        if (inner_children > sp) goto general; /* not a tree; the general path reports it */
+        if (!cleaf[1]) cr[1] = &recs[sp - 1];
+        if (!cleaf[0]) cr[0] = &recs[sp - 1 - !cleaf[1]];
+        int bad = 0;
+        for (int a = 0; a < 3; a++)
+            bad |= est_axis(p, nq, msc, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &rx.ax[a]) != 0;
+        if (bad) goto general;
+        int cs[3];
+        uint32_t pm[3] = {0, 0, 0}; /* relative: the node's lower bound at cs */
+        for (int a = 0; a < 3; a++) {
+            cs[a] = rx.ax[a].cs;
+            int shift = rx.ax[a].e - cs[a];
+            if (rel) pm[a] = shift >= nq ? 0 : (rx.ax[a].lb_mod << shift) & qmask;
+        }
+        uint64_t w[2];
+        int maybe[2] = {0, 0};
+        for (int c = 0; c < 2; c++) /* one branch per child, not per axis */
+            bad |= cleaf[c] ? leaf_codes(p, nq, cn[c], cs, pm, &w[c])
+                            : inner_codes(p, nq, msc, cr[c], cn[c], cs, pm, rel, &w[c], &maybe[c]);
+        if (bad) goto general;
+        for (int c = 0; c < 2; c++) cbvh_fast_put_node(nq, w[c], cleaf[c], slot[c], bytes + (size_t)c * nbytes);
+        stats->encodes++;
+        /* A child whose context may have changed: its actual context from
+         * the compressor (as the general path), compared as specified. */
+        for (int c = 1; c >= 0; c--) {
+            if (!maybe[c]) continue;
+            cbvh_node_ctx stored, actual;
+            rec_ctx(cr[c], &stored);
+            for (int a = 0; a < 3; a++) {
+                cbvh_axis_code code;
+                cbvh_axis_compress(p, cbvh_f32_of(cn[c]->lo[a]), cbvh_f32_of(cn[c]->hi[a]), cs[a], &code);
+                actual.axis[a] = cbvh_axis_child_ctx(&(cbvh_axis_ctx){rx.ax[a].e, cs[a], rx.ax[a].lb_mod, 0}, &code);
+            }
+            if (ctx_differs(o->enc, &stored, &actual) && backtrack(s, slot[c], &stored, &actual)) return -1;
+        }
+        sp -= inner_children;
+        recs[sp++] = rx;
+        bs->sp = sp;
+        return 0;
+    }
+
+general:;
+    /* ---- general path: the units, as specified */
+    cbvh_node_ctx est = {{{0}}};
+    uint32_t st = 0;
+    for (int a = 0; a < 3; a++) st |= cbvh_axis_root_ctx(p, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &est.axis[a]);
+    cbvh_child_in in[2];
+    cbvh_child_out co[2];
+    memset(in, 0, sizeof in);
+    if (leaf) {
+        child_in(n, slot[0], &in[0]);
+        in[1].empty = 1;
+    } else {
+        for (int c = 0; c < 2; c++) child_in(cn_in[c], slot[c], &in[c]);
+    }
+    st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
+    if (st & ENC_FAIL) {
+        snprintf(s->err, s->errlen, "cbvh bottom-up: pair %u rejected by the encoder (status 0x%x)", pair, st);
+        return -1;
+    }
+    stats->encodes++;
+    for (int c = 1; c >= 0 && !leaf; c--) {
+        if (in[c].leaf) continue;
+        cbvh_node_ctx stored, actual;
+        rec_ctx(&recs[--sp], &stored);
+        cbvh_child_ctx3(&est, &co[c], &actual);
+        if (ctx_differs(o->enc, &stored, &actual) && backtrack(s, in[c].ptr, &stored, &actual)) return -1;
+    }
+    bu_rec *r = &recs[sp++];
+    rec_of_ctx(&est, r);
+    for (int a = 0; a < 3 && !leaf; a++) /* exact coordinates for the parent's fast path */
+        r->ax[a].exact = floor2(cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), r->ax[a].e, &r->ax[a].k, &r->ax[a].ku);
+    bs->sp = sp;
+    return 0;
+}
+
+int cbvh_bu_inner(cbvh_bu_stream *s, const cbvh_bvh_node *n, const cbvh_bvh_node *const c[2], const uint32_t slot[2],
+                  uint32_t pair) {
+    return bu_step(s, n, c, slot, pair);
+}
+
+int cbvh_bu_leaf_root(cbvh_bu_stream *s, const cbvh_bvh_node *n, uint32_t slot, uint32_t pair) {
+    const uint32_t sl[2] = {slot, 0};
+    return bu_step(s, n, NULL, sl, pair);
+}
+
 int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_compress_opts *o, cbvh_tree *out,
                            cbvh_bu_stats *stats, char *err, size_t errlen) {
     memset(stats, 0, sizeof *stats);
@@ -316,17 +467,11 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
         cbvh_layout_free(&l);
         return -1;
     }
-    /* cbvh_tree_init has checked the parameters and that every pointer fits
-     * its field, so the fast path packs codes without the encoder's checks. */
     const cbvh_params *p = &o->params;
-    const int nq = p->quant_bits, msc = p->min_scale, rel = o->enc == CBVH_ENC_RELATIVE;
-    const uint32_t qmask = (1u << nq) - 1u;
-    const size_t pbytes = out->pair_bytes, nbytes = pbytes / 2;
-    bu_rec *recs = malloc(((size_t)l.npairs + 1) * sizeof *recs);
+    cbvh_bu_stream *s = cbvh_bu_open(o, out, stats, l.npairs, err, errlen);
     uint32_t *walk = malloc(((size_t)b->nnodes + 1) * sizeof *walk); /* node << 1 | children pushed */
-    bu_state s = {o, out, stats, malloc(((size_t)l.npairs + 2) * sizeof(bt_item)), err, errlen};
-    if (!recs || !walk || !s.stack) abort();
-    uint32_t sp = 0, ws = 0, npairs = 0, nids = 0, emitted = 0;
+    if (!walk) abort();
+    uint32_t ws = 0, npairs = 0, nids = 0, emitted = 0;
     int rc = 0, not_tree = 0;
     walk[ws++] = b->root << 1;
     /* Leaves are emitted without a walk step of their own: a left leaf child
@@ -367,98 +512,18 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
         if (leaf) { /* only the root is walked as a leaf */
             EMIT_LEAF(x);
             if (not_tree) break;
-        } else {
-            if (cbvh_bvh_is_leaf(&b->nodes[n->child[1]])) EMIT_LEAF(n->child[1]);
-            if (not_tree) break;
-            if ((not_tree = ++emitted > b->nnodes || npairs >= l.npairs)) break;
-            l.slot[x] = npairs++;
-            if (refit_tris) box_of_inner(b, x);
-        }
-        uint32_t pair = leaf ? out->root_pair : l.slot[x];
-        uint8_t *bytes = out->pairs + (size_t)pair * pbytes;
-
-        /* ---- fast path: an inner node whose boxes all take the integer steps */
-        if (!leaf) {
-            bu_rec rx;
-            const cbvh_bvh_node *cn[2] = {&b->nodes[n->child[0]], &b->nodes[n->child[1]]};
-            int cleaf[2] = {cbvh_bvh_is_leaf(cn[0]), cbvh_bvh_is_leaf(cn[1])};
-            /* the children's records: child 1's on top */
-            const bu_rec *cr[2] = {NULL, NULL};
-            uint32_t inner_children = (uint32_t)(!cleaf[0] + !cleaf[1]);
-            if (inner_children > sp) goto general; /* not a tree; the general path reports it */
-            if (!cleaf[1]) cr[1] = &recs[sp - 1];
-            if (!cleaf[0]) cr[0] = &recs[sp - 1 - !cleaf[1]];
-            int bad = 0;
-            for (int a = 0; a < 3; a++) bad |= est_axis(p, nq, msc, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &rx.ax[a]) != 0;
-            if (bad) goto general;
-            int cs[3];
-            uint32_t pm[3] = {0, 0, 0}; /* relative: the node's lower bound at cs */
-            for (int a = 0; a < 3; a++) {
-                cs[a] = rx.ax[a].cs;
-                int shift = rx.ax[a].e - cs[a];
-                if (rel) pm[a] = shift >= nq ? 0 : (rx.ax[a].lb_mod << shift) & qmask;
-            }
-            uint64_t w[2];
-            int maybe[2] = {0, 0};
-            for (int c = 0; c < 2; c++) /* one branch per child, not per axis */
-                bad |= cleaf[c] ? leaf_codes(p, nq, cn[c], cs, pm, &w[c])
-                                : inner_codes(p, nq, msc, cr[c], cn[c], cs, pm, rel, &w[c], &maybe[c]);
-            if (bad) goto general;
-            for (int c = 0; c < 2; c++)
-                cbvh_fast_put_node(nq, w[c], cleaf[c], l.slot[n->child[c]], bytes + (size_t)c * nbytes);
-            stats->encodes++;
-            /* A child whose context may have changed: its actual context from
-             * the compressor (as the general path), compared as specified. */
-            for (int c = 1; c >= 0; c--) {
-                if (!maybe[c]) continue;
-                cbvh_node_ctx stored, actual;
-                rec_ctx(cr[c], &stored);
-                for (int a = 0; a < 3; a++) {
-                    cbvh_axis_code code;
-                    cbvh_axis_compress(p, cbvh_f32_of(cn[c]->lo[a]), cbvh_f32_of(cn[c]->hi[a]), cs[a], &code);
-                    actual.axis[a] = cbvh_axis_child_ctx(&(cbvh_axis_ctx){rx.ax[a].e, cs[a], rx.ax[a].lb_mod, 0}, &code);
-                }
-                if (ctx_differs(o->enc, &stored, &actual) && backtrack(&s, l.slot[n->child[c]], &stored, &actual)) {
-                    rc = -1;
-                    break;
-                }
-            }
-            if (rc) break;
-            sp -= inner_children;
-            recs[sp++] = rx;
+            const uint32_t sl[2] = {l.slot[x], 0};
+            rc = bu_step(s, n, NULL, sl, out->root_pair);
             continue;
         }
-
-    general:;
-        /* ---- general path: the units, as specified */
-        cbvh_node_ctx est = {{{0}}};
-        uint32_t st = 0;
-        for (int a = 0; a < 3; a++)
-            st |= cbvh_axis_root_ctx(p, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &est.axis[a]);
-        cbvh_child_in in[2];
-        cbvh_child_out co[2];
-        cbvh_pair_inputs(b, &l, x, in);
-        st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
-        if (st & ENC_FAIL) {
-            snprintf(err, errlen, "cbvh bottom-up: pair %u rejected by the encoder (status 0x%x)", pair, st);
-            rc = -1;
-            break;
-        }
-        stats->encodes++;
-        for (int c = 1; c >= 0 && !leaf; c--) {
-            if (in[c].leaf) continue;
-            cbvh_node_ctx stored, actual;
-            rec_ctx(&recs[--sp], &stored);
-            cbvh_child_ctx3(&est, &co[c], &actual);
-            if (ctx_differs(o->enc, &stored, &actual) && backtrack(&s, in[c].ptr, &stored, &actual)) {
-                rc = -1;
-                break;
-            }
-        }
-        bu_rec *r = &recs[sp++];
-        rec_of_ctx(&est, r);
-        for (int a = 0; a < 3 && !leaf; a++) /* exact coordinates for the parent's fast path */
-            r->ax[a].exact = floor2(cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), r->ax[a].e, &r->ax[a].k, &r->ax[a].ku);
+        if (cbvh_bvh_is_leaf(&b->nodes[n->child[1]])) EMIT_LEAF(n->child[1]);
+        if (not_tree) break;
+        if ((not_tree = ++emitted > b->nnodes || npairs >= l.npairs)) break;
+        l.slot[x] = npairs++;
+        if (refit_tris) box_of_inner(b, x);
+        const cbvh_bvh_node *cn[2] = {&b->nodes[n->child[0]], &b->nodes[n->child[1]]};
+        const uint32_t sl[2] = {l.slot[n->child[0]], l.slot[n->child[1]]};
+        rc = bu_step(s, n, cn, sl, l.slot[x]);
     }
     if (rc == 0 && (not_tree || nids != l.nids || (!cbvh_bvh_is_leaf(&b->nodes[b->root]) && npairs != l.npairs))) {
         snprintf(err, errlen, "cbvh bottom-up: the BVH is not a tree (a node is reached twice or never)");
@@ -473,9 +538,8 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
         }
     }
 #undef EMIT_LEAF
-    free(recs);
     free(walk);
-    free(s.stack);
+    cbvh_bu_close(s);
     cbvh_layout_free(&l);
     if (rc) cbvh_tree_free(out);
     return rc;

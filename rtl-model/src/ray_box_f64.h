@@ -100,7 +100,7 @@ static inline void cbvh_rbf_prepare(const cbvh_ray *ray, int M, cbvh_rbf_ray *p)
 static inline int cbvh_rbf_decided(uint64_t b, uint64_t mask) {
     uint64_t ex = (b >> 52) & 0x7FFu;
     uint64_t low = b & mask;
-    return (ex - (1023u - 126u)) <= 252u && (low - 8u) <= mask - 15u;
+    return ((ex - (1023u - 126u)) <= 252u) & ((low - 8u) <= mask - 15u); /* & : no branches */
 }
 
 /* RD_M and RU_M of the reals near a decided t^ (its M-bit cell's ends). */
@@ -159,7 +159,7 @@ static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double
         const double *pn = p->near_hi[a] ? hi[a] : lo[a], *pf = p->near_hi[a] ? lo[a] : hi[a];
         for (int c = 0; c < 2; c++) {
             double w = hi[a][c] - lo[a][c];
-            okv[c] &= w >= 0 && w <= DBL_MAX;
+            okv[c] &= (w >= 0) & (w <= DBL_MAX);
             double n = (pn[c] - p->o[a]) * p->inv[a], f = (pf[c] - p->o[a]) * p->inv[a];
             nh[c] = n > nh[c] ? n : nh[c];
             fh[c] = f < fh[c] ? f : fh[c];

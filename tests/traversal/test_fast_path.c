@@ -18,6 +18,7 @@
 
 #include "../../rtl-model/src/ray_prep.h"
 #include "cbvh/traversal_units.h"
+#include "test_util.h"
 
 #ifdef CBVH_SANITIZE
 #define NBOX 400000
@@ -29,12 +30,7 @@
 
 static long failures;
 static uint64_t rs = 0x9E3779B97F4A7C15u;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint32_t below(uint32_t n) { return (uint32_t)(rnd() % n); }
 
 /* 1 for a quarter of the inputs: scene-like values (no specials, exponents

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
+#include "test_util.h"
 
 #ifdef CBVH_SANITIZE
 #define N_CASES 150000
@@ -21,12 +22,7 @@
 #endif
 
 static uint64_t rs = 0x9E3779B97F4A7C15u;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint64_t below(uint64_t n) { return rnd() % n; }
 
 static cbvh_f32 mkf(int sign, int e, uint32_t frac) {

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
+#include "test_util.h"
 
 #ifdef CBVH_SANITIZE
 #define LEAK_RAYS 120000
@@ -24,24 +25,9 @@
 
 static long failures;
 static uint64_t rs = 0x2545F4914F6CDD1Du;
-static uint64_t rnd(void) {
-    rs ^= rs << 13;
-    rs ^= rs >> 7;
-    rs ^= rs << 17;
-    return rs;
-}
+static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint64_t below(uint64_t n) { return rnd() % n; }
-static double unit(void) { return (double)(rnd() >> 11) / 9007199254740992.0; }
-static cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
+static double unit(void) { return tu_unit_d(&rs); }
 
 typedef struct {
     int nv, nt;

@@ -83,6 +83,15 @@ typedef struct {
 int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_compress_opts *o, cbvh_tree *out,
                            cbvh_bu_stats *st, char *err, size_t errlen);
 
+/* Fused streaming build: the LBVH of cbvh_build_lbvh with the bottom-up
+ * compression done inside its bottom-up pass (each inner node compressed as
+ * the LBVH completes it, in post-order; no second walk).  bvh, out and st are
+ * bit for bit those of cbvh_build_lbvh followed by cbvh_compress_bottomup
+ * (refit_tris = NULL), and so is the error message.  0, or -1 + reason with
+ * bvh and out empty. */
+int cbvh_build_lbvh_streaming(const cbvh_scene *s, const cbvh_compress_opts *o, cbvh_bvh *bvh, cbvh_tree *out,
+                              cbvh_bu_stats *st, char *err, size_t errlen);
+
 /* Decode the whole CBVH and prove it against its float BVH: same topology and
  * leaves, every decoded child box encloses the float box, ID flags right,
  * every pair used once.  0 or -1 + reason (first failure). */
