@@ -107,19 +107,29 @@ uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3],
  * goes to the exact path, so the unit's results stay integer-defined: the
  * filter chooses between computations proven to give the same outputs.
  *
- * Error bound: every quantity is a polynomial in the binary32 inputs, each
- * evaluated as a tree of +, -, x.  With u = 2^-53, and no underflow or
- * overflow (binary32 inputs keep every nonzero intermediate magnitude within
- * [2^-960, 2^650]), the computed y^ satisfies |y^ - y| <= gamma_k * A where k
- * is the number of roundings on the deepest path and A is the same
- * expression on absolute values with - read as + (Higham, ASNA 2nd ed.,
- * sec. 3.1-3.3).  A is itself computed with + and x only, A^ >= A (1 - gamma_k).
- * Depths: P = v - o 1, X = P_x d_z - P_z d_x 3, U = X_2 Y_1 - Y_2 X_1 5,
- * T = U Z_0 + V Z_1 + W Z_2 9.  So |U^ - U| <= 6u A^_U < 2^-48 A^_U and
- * |T^ - T| <= 10u A^_T < 2^-47 A^_T, and |y^| > bound proves sign(y^) =
- * sign(y).  A fused multiply-add only removes roundings, so the bound also
- * holds if the compiler contracts (the file is compiled with
- * -ffp-contract=off anyway, so the filter's decisions are reproducible). */
+ * Error bounds (running, u = 2^-53): binary32 inputs are exact in binary64
+ * and keep every nonzero intermediate within [2^-960, 2^650] (no underflow or
+ * overflow), so each operation is exact up to a factor (1 + d), |d| <= u.
+ * Each computed y^ carries a bound e_y >= |y^ - y| formed from computed
+ * values:
+ *   P = v - o                       |P^ - P| <= u |P|
+ *   X = P_x d_z - P_z d_x           e_X = 4u (|P_x^| |d_z| + |P_z^| |d_x|)   (3.0002u suffices)
+ *   Z = P_z                         e_Z = 1.0001u |Z^|
+ *   U = X_k Y_j - Y_k X_j           e_U = |X_k^| e_Yj + |Y_j^| e_Xk + e_Xk e_Yj (+ the same for Y_k X_j)
+ *                                         + 2.0001u (|X_k^ Y_j^| + |Y_k^ X_j^|)   (product and sum roundings)
+ *   T = U Z_0 + V Z_1 + W Z_2       e_T = sum (|E_i^| e_Zi + |Z_i^| e_Ei + e_Ei e_Zi) + 3.001u sum |E_i^ Z_i^|
+ *   det = U + V + W                 e_det = sum e_Ei + 2.0001u |det^|   (terms of one sign)
+ *   det d_z                         |d_z| e_det + 1.0001u |den^|
+ * (propagation: x^ y^ - x y = x^ (y^ - y) + y^ (x^ - x) - (x^ - x)(y^ - y)).
+ * Sums of positive terms are computed with at most a dozen roundings, so
+ * they are multiplied by 1.001 to stay upper bounds.  |y^| > e_y proves
+ * sign(y^) = sign(y).  The bounds grow with the triangle's distance from the
+ * ray origin over its size (not its square, as bounds on absolute-value
+ * expressions would), which keeps small, distant triangles decidable.  A
+ * fused multiply-add only removes roundings and the margins cover the
+ * bounds' own rounding, so the bounds also hold if the compiler contracts
+ * (the file is compiled with -ffp-contract=off anyway, so the filter's
+ * decisions are reproducible). */
 static double dabs(double x) { return x < 0 ? -x : x; }
 static double f32d(cbvh_f32 b) {
     float f;
@@ -181,55 +191,63 @@ void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p) {
  * path decides).  p->ok and finite vertices required. */
 static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
                   int fill_hit, cbvh_tri_result *out) {
+    const double u = 0x1p-53;
     int kx = p->kx, ky = p->ky, kz = p->kz;
     double dx = p->dx, dy = p->dy, dz = p->dz;
     double adx = dabs(dx), ady = dabs(dy), adz = dabs(dz);
     double ox = p->ox, oy = p->oy, oz = p->oz;
-    double aox = dabs(ox), aoy = dabs(oy), aoz = dabs(oz);
     const cbvh_f32 *v[3] = {v0, v1, v2};
-    double X[3], Y[3], Z[3], AX[3], AY[3], AZ[3];
+    /* X, Y, Z and bounds eX, eY, eZ on their errors (see the top of the
+     * section): |X^ - X| <= 3.0002u (|px^ dz| + |pz^ dx|) < 4u (...)^ */
+    double X[3], Y[3], Z[3], eX[3], eY[3], eZ[3];
     for (int i = 0; i < 3; i++) {
         double vx = f32d(v[i][kx]), vy = f32d(v[i][ky]), vz = f32d(v[i][kz]);
         double px = vx - ox, py = vy - oy, pz = vz - oz;
-        double apx = dabs(vx) + aox, apy = dabs(vy) + aoy, apz = dabs(vz) + aoz;
+        double apz = dabs(pz);
         X[i] = px * dz - pz * dx;
         Y[i] = py * dz - pz * dy;
         Z[i] = pz;
-        AX[i] = apx * adz + apz * adx;
-        AY[i] = apy * adz + apz * ady;
-        AZ[i] = apz;
+        eX[i] = 4.0 * u * (dabs(px) * adz + apz * adx);
+        eY[i] = 4.0 * u * (dabs(py) * adz + apz * ady);
+        eZ[i] = 1.0001 * u * apz;
     }
-    double E[3], AE[3];
+    /* E_i = X_k Y_j - Y_k X_j: propagated error of the inputs plus the three
+     * roundings; every term positive, so the computed sum times 1.001 is an
+     * upper bound. */
+    double E[3], eE[3];
     int sg[3];
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3, k = (i + 2) % 3;
-        E[i] = X[k] * Y[j] - Y[k] * X[j];
-        AE[i] = AX[k] * AY[j] + AY[k] * AX[j];
-        double b = AE[i] * 0x1p-48;
-        sg[i] = E[i] > b ? 1 : E[i] < -b ? -1 : 0; /* 0: sign unknown */
+        double a = X[k] * Y[j], c = Y[k] * X[j];
+        E[i] = a - c;
+        eE[i] = 1.001 * (dabs(X[k]) * eY[j] + dabs(Y[j]) * eX[k] + eX[k] * eY[j] + dabs(Y[k]) * eX[j] +
+                         dabs(X[j]) * eY[k] + eX[j] * eY[k] + 2.0001 * u * (dabs(a) + dabs(c)));
+        sg[i] = E[i] > eE[i] ? 1 : E[i] < -eE[i] ? -1 : 0; /* 0: sign unknown */
     }
     if ((sg[0] < 0 || sg[1] < 0 || sg[2] < 0) && (sg[0] > 0 || sg[1] > 0 || sg[2] > 0)) return 1;
     if (sg[0] == 0 || sg[0] != sg[1] || sg[1] != sg[2]) return 0;
-    /* U, V, W certainly of one strict sign: det has that sign, det != 0 */
-    double T = E[0] * Z[0] + E[1] * Z[1] + E[2] * Z[2];
-    double AT = AE[0] * AZ[0] + AE[1] * AZ[1] + AE[2] * AZ[2];
-    double b = AT * 0x1p-47;
-    int sT = T > b ? 1 : T < -b ? -1 : 0;
+    /* U, V, W certainly of one strict sign: det has that sign, det != 0.
+     * T = U Z0 + V Z1 + W Z2: propagated error plus 3 products and 2 sums. */
+    double P0 = E[0] * Z[0], P1 = E[1] * Z[1], P2 = E[2] * Z[2];
+    double T = P0 + P1 + P2;
+    double eT = 0;
+    for (int i = 0; i < 3; i++) eT += dabs(E[i]) * eZ[i] + dabs(Z[i]) * eE[i] + eE[i] * eZ[i];
+    eT = 1.001 * (eT + 3.001 * u * (dabs(P0) + dabs(P1) + dabs(P2)));
+    int sT = T > eT ? 1 : T < -eT ? -1 : 0;
     int sden = sg[0] * (dz > 0 ? 1 : -1); /* d_z != 0: the largest |d| of a nonzero d */
     if (sT == 0) return 0;
     if (sT != sden) return 1;
     if (!fill_hit) return 0;
     /* A certain hit: t = T / (det d_z), b1 = V / det, b2 = W / det, each the
-     * truncation of a positive quotient.  det = U + V + W: its terms share a
-     * strict sign, so the two additions add at most 2^-52 |det| to the
-     * 2^-48 A^ error of the terms (bound taken as 2^-47 A^); d_z is exact and
-     * det d_z adds one rounding. */
+     * truncation of a positive quotient.  det = U + V + W adds two roundings
+     * (its terms share a sign: <= 2.0001u sum |E|); det d_z one more. */
     double det = E[0] + E[1] + E[2], adet = dabs(det);
-    double r_det = (AE[0] + AE[1] + AE[2]) * 0x1p-47 / adet;
-    double r_den = r_det + 0x1p-52, r_T = b / dabs(T);
-    cbvh_f32 t = quot_trunc(T, det * dz, r_T, r_den);
-    cbvh_f32 b1 = quot_trunc(E[1], det, AE[1] * 0x1p-48 / dabs(E[1]), r_det);
-    cbvh_f32 b2 = quot_trunc(E[2], det, AE[2] * 0x1p-48 / dabs(E[2]), r_det);
+    double e_det = 1.001 * (eE[0] + eE[1] + eE[2] + 2.0001 * u * adet);
+    double den = det * dz, r_det = e_det / adet;
+    double r_den = (adz * e_det + 1.0001 * u * dabs(den)) / dabs(den);
+    cbvh_f32 t = quot_trunc(T, den, eT / dabs(T), r_den);
+    cbvh_f32 b1 = quot_trunc(E[1], det, eE[1] / dabs(E[1]), r_det);
+    cbvh_f32 b2 = quot_trunc(E[2], det, eE[2] / dabs(E[2]), r_det);
     if (!t || !b1 || !b2) return 0;
     memset(out, 0, sizeof *out);
     out->hit = 1;
