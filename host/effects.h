@@ -71,7 +71,7 @@ typedef struct {
     uint64_t hits;
     uint64_t rejected;        /* rays a unit rejected (NaN/Inf, zero direction): no hit */
     cbvh_trav_stats st;       /* summed counters; max_stack = deepest */
-    double cpu_seconds;       /* process CPU time spent in traversal */
+    double cpu_seconds;       /* time spent in traversal (per-ray monotonic clock, its cost removed) */
 } cbvh_fx_stats;
 
 /* Invocations per unit (docs/scenes.md §Units). */
