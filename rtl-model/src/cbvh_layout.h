@@ -34,16 +34,7 @@ static inline void cbvh_tree_put_ids(cbvh_tree *t, const cbvh_bvh *b, const cbvh
         t->ids[first + j] = b->prims[n->first + j] | (j + 1 == n->count ? CBVH_ID_LAST : 0u);
 }
 
-static inline cbvh_f32 cbvh_f32_of(float x) {
-    cbvh_f32 r;
-    memcpy(&r, &x, sizeof r);
-    return r;
-}
-static inline float cbvh_float_of(cbvh_f32 x) {
-    float r;
-    memcpy(&r, &x, sizeof r);
-    return r;
-}
+/* cbvh_f32_of, cbvh_float_of: cbvh/fp32.h */
 
 /* Node-pair input for float node c. */
 static inline void cbvh_child_from_node(const cbvh_bvh *b, const cbvh_layout *l, uint32_t c, cbvh_child_in *in) {

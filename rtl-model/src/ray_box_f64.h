@@ -50,18 +50,10 @@ typedef struct {
     int ok;         /* the filter applies to this ray (finite, no zero d_a, valid M) */
 } cbvh_rbf_ray;
 
-static inline double cbvh_rbf_f32(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return (double)f;
-}
+static inline double cbvh_rbf_f32(cbvh_f32 b) { return (double)cbvh_float_of(b); }
 
-static inline cbvh_f32 cbvh_rbf_to_f32(double x) {
-    float f = (float)x; /* exact for the values passed (binary32 or M-bit normal) */
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
+/* exact for the values passed (binary32 or M-bit normal) */
+static inline cbvh_f32 cbvh_rbf_to_f32(double x) { return cbvh_f32_of((float)x); }
 
 static inline uint64_t cbvh_rbf_bits(double x) {
     uint64_t b;

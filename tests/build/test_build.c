@@ -14,6 +14,7 @@
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
+#include "test_util.h"
 #include "scene_load.h"
 
 #ifndef CBVH_SCENES_DIR
@@ -47,12 +48,7 @@ static void load_bunny(cbvh_scene *s) {
 }
 
 static uint32_t rng_state = 12345u;
-static uint32_t rnd(void) {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 17;
-    rng_state ^= rng_state << 5;
-    return rng_state;
-}
+static uint32_t rnd(void) { return tu_xorshift32(&rng_state); }
 static float rndf(void) { return (float)(rnd() & 0xFFFFFF) / 16777216.0f; }
 
 static void random_scene(cbvh_scene *s, uint32_t n, float spread, float size) {

@@ -16,6 +16,7 @@
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
+#include "test_util.h"
 #include "scene_load.h"
 
 #ifndef CBVH_SCENES_DIR
@@ -23,12 +24,7 @@
 #endif
 
 static uint32_t rng_state = 987654321u;
-static uint32_t rnd(void) {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 17;
-    rng_state ^= rng_state << 5;
-    return rng_state;
-}
+static uint32_t rnd(void) { return tu_xorshift32(&rng_state); }
 static float rndf(void) { return (float)(rnd() & 0xFFFFFF) / 16777216.0f; }
 
 static cbvh_compress_opts opts(int n, int min_scale, cbvh_encoding enc, int treelet, int naive) {

@@ -31,20 +31,19 @@ static inline uint64_t tu_xorshift64(uint64_t *s) {
     *s ^= *s << 17;
     return *s;
 }
+/* xorshift32 (13, 17, 5), for the tests that use 32-bit states. */
+static inline uint32_t tu_xorshift32(uint32_t *s) {
+    *s ^= *s << 13;
+    *s ^= *s >> 17;
+    *s ^= *s << 5;
+    return *s;
+}
 /* Uniform in [0, 1) from the top 53 bits, as a double and rounded to float. */
 static inline double tu_unit_d(uint64_t *s) { return (double)(tu_xorshift64(s) >> 11) / 9007199254740992.0; }
 static inline float tu_unit_f(uint64_t *s) { return (float)tu_unit_d(s); }
 
-/* binary32 bit pattern of a float, and back. */
-static inline cbvh_f32 fb(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static inline float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
+/* binary32 bit pattern of a float, and back (short names for the tests). */
+static inline cbvh_f32 fb(float f) { return cbvh_f32_of(f); }
+static inline float bf(cbvh_f32 b) { return cbvh_float_of(b); }
 
 #endif

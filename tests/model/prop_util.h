@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "cbvh/datapath.h"
+#include "test_util.h" /* fb, bf (tests/common) */
 
 /* ---- PRNG: splitmix64, seeded, identical at every optimisation level ---- */
 typedef struct {
@@ -31,17 +32,7 @@ static inline uint64_t prng_next(prng *r) {
 static inline uint32_t prng_below(prng *r, uint32_t n) { return (uint32_t)((prng_next(r) >> 32) % n); }
 static inline int prng_range(prng *r, int lo, int hi) { return lo + (int)prng_below(r, (uint32_t)(hi - lo + 1)); }
 
-/* ---- bit patterns ---- */
-static inline float b2f(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-static inline cbvh_f32 f2b(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
+/* ---- bit patterns (fb, bf: tests/common/test_util.h) ---- */
 /* monotone integer key of a finite pattern (both zeros -> 0) and back (0 -> +0) */
 static inline int64_t fkey(cbvh_f32 b) { return (b & CBVH_F32_SIGN) ? -(int64_t)(b & ~CBVH_F32_SIGN) : (int64_t)b; }
 static inline cbvh_f32 unkey(int64_t k) { return k < 0 ? (CBVH_F32_SIGN | (cbvh_f32)(-k)) : (cbvh_f32)k; }
@@ -93,9 +84,9 @@ static inline cbvh_f32 prop_point_in(prng *r, cbvh_f32 lo, cbvh_f32 hi) {
     case 5: return unkey(a + (int64_t)(prng_next(r) % (uint64_t)(b - a + 1)));
     default: {
         double t = (double)(prng_next(r) >> 11) * 0x1p-53;
-        double v = (double)b2f(lo) + t * ((double)b2f(hi) - (double)b2f(lo));
+        double v = (double)bf(lo) + t * ((double)bf(hi) - (double)bf(lo));
         float f = (float)v; /* round to nearest, then clamp into [lo, hi] */
-        cbvh_f32 x = f2b(f);
+        cbvh_f32 x = fb(f);
         if ((x & CBVH_F32_EXP) == CBVH_F32_EXP || fkey(x) < a) x = lo;
         if (fkey(x) > b) x = hi;
         return x;
@@ -144,11 +135,11 @@ static inline cbvh_f32 oracle_round_d(double v, int mode) {
     volatile double vv = v;
     volatile float f = (float)vv;
     fesetround(FE_TONEAREST);
-    cbvh_f32 b = f2b(f);
+    cbvh_f32 b = fb(f);
     return (b & ~CBVH_F32_SIGN) == 0 ? 0u : b;
 }
 
-static inline double f32_as_double(cbvh_f32 b) { return (double)b2f(b); }
+static inline double f32_as_double(cbvh_f32 b) { return (double)bf(b); }
 
 /* Eq. 2, by a loop: smallest k >= min_scale with cells * 2^e <= 2^N * 2^k. */
 static inline int oracle_child_scale(int n, int min_scale, int e, double cells) {

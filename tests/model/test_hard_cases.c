@@ -91,7 +91,6 @@ static void chains_all_params(cbvh_f32 lb, cbvh_f32 ub, prng *r) {
 }
 
 static cbvh_f32 ulps(cbvh_f32 x, int k) { return unkey(fkey(x) + k); }
-static cbvh_f32 fb(float f) { return f2b(f); }
 
 /* ---- cloth: a finely tessellated plane at z = -0.4 ---------------------- */
 #define CLOTH_G 64 /* 64 x 64 quads, 8192 triangles */

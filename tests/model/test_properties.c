@@ -231,7 +231,7 @@ static void prop_decode_random(prng *r, long iters) {
             prop_fail("decode: status %#x", st);
             continue;
         }
-        long double u = ctx.clb == CBVH_F32_NEG_INF ? -ldexpl(1.0L, 128) : (long double)b2f(ctx.clb);
+        long double u = ctx.clb == CBVH_F32_NEG_INF ? -ldexpl(1.0L, 128) : (long double)bf(ctx.clb);
         cbvh_axis_code o;
         o.lb_mod = (rr + pmod) & mask;
         o.ub_mod = (ss + pmod) & mask;
@@ -244,8 +244,8 @@ static void prop_decode_random(prng *r, long iters) {
         volatile long double hi = u + ldexpl((long double)ss, ctx.scale);
         volatile float fhi = (float)hi;
         fesetround(FE_TONEAREST);
-        o.clb = f2b(flo);
-        o.cub = f2b(fhi);
+        o.clb = fb(flo);
+        o.cub = fb(fhi);
         if ((o.clb & ~CBVH_F32_SIGN) == 0) o.clb = 0;
         if ((o.cub & ~CBVH_F32_SIGN) == 0) o.cub = 0;
         if (!code_equal(&d, &o))
@@ -399,7 +399,7 @@ static cbvh_f32 ld_to_f32(long double v, int mode) {
     volatile long double vv = v;
     volatile float f = (float)vv;
     fesetround(FE_TONEAREST);
-    cbvh_f32 b = f2b(f);
+    cbvh_f32 b = fb(f);
     return (b & ~CBVH_F32_SIGN) == 0 ? 0u : b;
 }
 
@@ -450,12 +450,12 @@ static void prop_fp32(prng *r, long iters) {
 
         /* cmp / next_up / next_down */
         cbvh_f32 x = prop_random_float(r), y = prng_below(r, 4) ? prop_random_float(r) : x ^ (prng_below(r, 2) << 31);
-        float fx = b2f(x), fy = b2f(y);
+        float fx = bf(x), fy = bf(y);
         int c = cbvh_f32_cmp(x, y);
         digest_u32(&dg, (uint32_t)c);
         if (c != ((fx > fy) - (fx < fy))) prop_fail("cmp(%08x,%08x) = %d", x, y, c);
         cbvh_f32 nu = cbvh_f32_next_up(x), nd = cbvh_f32_next_down(x);
-        if (b2f(nu) != nextafterf(fx, INFINITY) || b2f(nd) != nextafterf(fx, -INFINITY))
+        if (bf(nu) != nextafterf(fx, INFINITY) || bf(nd) != nextafterf(fx, -INFINITY))
             prop_fail("next_up/down(%08x)", x);
     }
 }

@@ -8,6 +8,7 @@
 #define CBVH_FP32_H
 
 #include <stdint.h>
+#include <string.h>
 
 typedef uint32_t cbvh_f32; /* binary32 bit pattern */
 
@@ -51,6 +52,18 @@ static inline int cbvh_bitlen64(uint64_t x) {
     int n = 0;
     while (x) { n++; x >>= 1; }
     return n;
+}
+
+/* A float's binary32 bit pattern and back (the host's float is binary32). */
+static inline cbvh_f32 cbvh_f32_of(float x) {
+    cbvh_f32 r;
+    memcpy(&r, &x, sizeof r);
+    return r;
+}
+static inline float cbvh_float_of(cbvh_f32 x) {
+    float r;
+    memcpy(&r, &x, sizeof r);
+    return r;
 }
 
 #endif
