@@ -25,6 +25,8 @@ static void usage(FILE *f) {
             "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
             "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,F...]]\n"
             "                        [--one-sided]\n"
+            "  SCENE is a scene file (.scene, .json) or a mesh file / proc:NAME (its default scene,\n"
+            "  docs/scenes.md).\n"
             "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
             "  setting N x M x E, on the same rays, and prints per setting and effect: box and triangle\n"
             "  tests, bytes per ray, node memory, modelled time and CPU time, each relative to the float\n"
@@ -450,7 +452,7 @@ int cmd_sweep(int argc, char **argv) {
     }
     cbvh_scene_desc d;
     char err[1024];
-    if (cbvh_scene_file_load(scene, &d, err, sizeof err)) {
+    if (cbvh_scene_file_open(scene, &d, err, sizeof err)) {
         fprintf(stderr, "cbvh sweep: %s\n", err);
         return 2;
     }

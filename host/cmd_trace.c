@@ -15,6 +15,8 @@ static void usage(FILE *f) {
     fprintf(f,
             "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format float|cbvh|qbvh|tlist...]\n"
             "                        [--spp K] [--one-sided] [--json]\n"
+            "  SCENE is a scene file (.scene, .json) or a mesh file / proc:NAME (its default scene,\n"
+            "  docs/scenes.md).\n"
             "  Traces the rays the scene file's effects call for (docs/scenes.md) and prints, per effect:\n"
             "  rays, box/triangle tests, nodes and bytes per ray, deepest stack, modelled time per ray\n"
             "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default), qbvh\n"
@@ -221,7 +223,7 @@ int cmd_trace(int argc, char **argv) {
     }
     cbvh_scene_desc d;
     char err[1024];
-    if (cbvh_scene_file_load(scene, &d, err, sizeof err)) {
+    if (cbvh_scene_file_open(scene, &d, err, sizeof err)) {
         fprintf(stderr, "cbvh trace: %s\n", err);
         return 2;
     }

@@ -102,6 +102,17 @@ int cbvh_scene_file_load(const char *path, cbvh_scene_desc *out, char *err, size
  * where a relative mesh path is looked up. */
 int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *out, char *err, size_t errlen);
 
+/* The default scene of a bare mesh (host/scene_default.c, docs/scenes.md):
+ * 256x192 pinhole at centre + (0.45, 0.35, 1.9) x the largest extent E, looking at
+ * the centre (y up, 35 degrees); one point light at centre + (1, 2, 1) E; a diffuse
+ * floor 3x the mesh; primary, hard shadows, ambient occlusion (2 samples, distance
+ * 0.2 E); seed 1. */
+int cbvh_scene_file_default(const char *mesh, cbvh_scene_desc *out, char *err, size_t errlen);
+/* 1 unless arg ends in .scene or .json. */
+int cbvh_scene_arg_is_mesh(const char *arg);
+/* A scene file, or the default scene of a mesh file / proc:NAME. */
+int cbvh_scene_file_open(const char *arg, cbvh_scene_desc *out, char *err, size_t errlen);
+
 void cbvh_scene_desc_free(cbvh_scene_desc *d);
 
 /* Triangles of frame f (0 .. frames-1; a static scene has one frame) into
