@@ -52,17 +52,29 @@ static inline uint64_t cbvh_fast_load_le32(const uint8_t *b) {
  * N <= 10 the codes and the leaf bit lie in the first 64 bits; a 96-bit node
  * (N >= 7, P = 32) has its pointer's top bits and the reserved bits
  * [6N + 33, 96) in the last 32. */
-static inline int cbvh_fast_pair_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
-                                        const uint8_t *bytes, cbvh_fast_child ch[2]) {
+static inline int cbvh_fast_params_ok(const cbvh_params *p) {
+    return p->quant_bits >= CBVH_N_MIN && p->quant_bits <= CBVH_N_MAX && p->min_scale >= CBVH_SCALE_FLOOR &&
+           p->min_scale <= CBVH_SCALE_CEIL;
+}
+
+static inline int cbvh_fast_node_ctx_ok(const cbvh_params *p, const cbvh_node_ctx *c) {
+    return cbvh_fast_ctx_ok(p, &c->axis[0]) & cbvh_fast_ctx_ok(p, &c->axis[1]) & cbvh_fast_ctx_ok(p, &c->axis[2]);
+}
+
+/* The decode proper, for valid parameters (cbvh_fast_params_ok) and a valid
+ * context (cbvh_fast_node_ctx_ok, or valid by construction: every context
+ * cbvh_fast_child_ctx derives from a valid one is valid, see there).  Also
+ * gives each axis's pmod (cbvh_fast_pmod, whatever the encoding) for the
+ * children's contexts. */
+static inline int cbvh_fast_pair_decode_valid(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
+                                              const uint8_t *bytes, cbvh_fast_child ch[2], uint32_t pm[3]) {
     int n = p->quant_bits;
-    if (n < CBVH_N_MIN || n > CBVH_N_MAX || p->min_scale < CBVH_SCALE_FLOOR || p->min_scale > CBVH_SCALE_CEIL)
-        return 0;
     int wide = n > 6, node_bytes = wide ? 12 : 8;
     uint32_t mask = cbvh_grid_mask(p), full = mask + 1u;
     uint32_t pmod[3];
     for (int a = 0; a < 3; a++) {
-        if (!cbvh_fast_ctx_ok(p, &ctx->axis[a])) return 0;
-        pmod[a] = enc == CBVH_ENC_MODULO ? cbvh_fast_pmod(p, &ctx->axis[a]) : 0; /* relative: r, s = codes */
+        pm[a] = cbvh_fast_pmod(p, &ctx->axis[a]);
+        pmod[a] = enc == CBVH_ENC_MODULO ? pm[a] : 0; /* relative: r, s = codes */
     }
     int pp = 6 * n + 1;                                 /* pointer position */
     int pb = wide || 64 - pp >= 32 ? 32 : 64 - pp;      /* pointer bits */
@@ -93,17 +105,31 @@ static inline int cbvh_fast_pair_decode(const cbvh_params *p, cbvh_encoding enc,
     return 1;
 }
 
+/* The same with the parameters and the context checked first. */
+static inline int cbvh_fast_pair_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
+                                        const uint8_t *bytes, cbvh_fast_child ch[2]) {
+    uint32_t pm[3];
+    return cbvh_fast_params_ok(p) && cbvh_fast_node_ctx_ok(p, ctx) &&
+           cbvh_fast_pair_decode_valid(p, enc, ctx, bytes, ch, pm);
+}
+
 /* The context of child c along axis a, as cbvh_axis_child_ctx gives it from
  * the unit's decode: {scale, child_scale(s - r), (r + pmod) mod 2^N,
- * clb = RD(u + r 2^e)}.  plo: u + r 2^e exactly in binary64 (or NULL); clb is
- * rounded from it when the result is normal or zero, else the unit
- * (cbvh_axis_decode) computes it. */
+ * clb = RD(u + r 2^e)}.  ppm: the parent context's pmod along a (from
+ * cbvh_fast_pair_decode_valid).  plo: u + r 2^e exactly in binary64 (or
+ * NULL); clb is rounded from it when the result is normal or zero, else the
+ * unit (cbvh_axis_decode) computes it.
+ * Valid when pc is: parent_scale = pc's scale <= 126; the child scale lies in
+ * [min_scale, pc's scale] (cells s - r <= 2^N, clamped to min_scale <= pc's
+ * scale); lb_mod is masked; clb is finite or -Inf (RD never rounds to +Inf or
+ * NaN: a positive overflow gives FLT_MAX). */
 static inline void cbvh_fast_child_ctx(const cbvh_params *p, cbvh_encoding enc, const cbvh_axis_ctx *pc,
-                                       const cbvh_fast_child *fc, int a, const double *plo, cbvh_axis_ctx *cc) {
+                                       uint32_t ppm, const cbvh_fast_child *fc, int a, const double *plo,
+                                       cbvh_axis_ctx *cc) {
     uint32_t r = fc->r[a];
     cc->parent_scale = pc->scale;
     cc->scale = cbvh_grid_child_scale(p, pc->scale, fc->s[a] - r);
-    cc->lb_mod = (r + cbvh_fast_pmod(p, pc)) & cbvh_grid_mask(p);
+    cc->lb_mod = (r + ppm) & cbvh_grid_mask(p);
     if (!plo || !cbvh_rbf_rd32(*plo, &cc->clb)) {
         cbvh_axis_code code;
         cbvh_axis_decode(p, enc, pc, fc->lc[a], fc->uc[a], &code);

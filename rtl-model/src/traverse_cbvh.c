@@ -15,6 +15,7 @@
 
 typedef struct {
     int leaf;
+    int ctx_ok; /* ctx known valid (the root's, checked, or derived by cbvh_fast_child_ctx) */
     uint32_t ptr;
     cbvh_node_ctx ctx; /* inner: the child's own context */
     double t_near;     /* binary64: its order is the unit's key order */
@@ -50,7 +51,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     cbvh_rbf_ray fp;
     cbvh_rbf_prepare(ray, mant_bits, &fp);
     const cbvh_params *prm = &t->params;
-    int fast_codec = t->pair_bytes == cbvh_nodepair_bytes(prm->quant_bits);
+    int fast_codec = cbvh_fast_params_ok(prm) && t->pair_bytes == cbvh_nodepair_bytes(prm->quant_bits);
 
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;
@@ -71,6 +72,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     }
     if (rhit) {
         stack[0].leaf = 0;
+        stack[0].ctx_ok = fast_codec && cbvh_fast_node_ctx_ok(prm, &t->root_ctx);
         stack[0].ptr = t->root_pair;
         stack[0].ctx = t->root_ctx;
         stack[0].t_near = rtn;
@@ -104,7 +106,9 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
         double tn[2];
         int h[2] = {0, 0};
         cbvh_fast_child fc[2];
-        if (fast_codec && cbvh_fast_pair_decode(prm, t->enc, &ctx, pair, fc)) {
+        uint32_t ppm[3];
+        if (fast_codec && (e->ctx_ok || cbvh_fast_node_ctx_ok(prm, &ctx)) &&
+            cbvh_fast_pair_decode_valid(prm, t->enc, &ctx, pair, fc, ppm)) {
             cbvh_rbf_axis ax[3];
             for (int a = 0; a < 3; a++) ax[a] = cbvh_rbf_axis_prep(ctx.axis[a].clb, ctx.axis[a].scale);
             int exact = ax[0].exact & ax[1].exact & ax[2].exact;
@@ -141,12 +145,13 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                 if (!h[c]) continue;
                 entry *ne = &stack[sp++];
                 ne->leaf = fc[c].leaf;
+                ne->ctx_ok = 1;
                 ne->ptr = fc[c].ptr;
                 ne->t_near = tn[c];
                 if (ne->leaf) continue; /* a leaf entry's context is never read */
                 for (int a = 0; a < 3; a++) {
-                    cbvh_fast_child_ctx(prm, t->enc, &ctx.axis[a], &fc[c], a, ax[a].exact ? &lo[a][c] : NULL,
-                                        &ne->ctx.axis[a]);
+                    cbvh_fast_child_ctx(prm, t->enc, &ctx.axis[a], ppm[a], &fc[c], a,
+                                        ax[a].exact ? &lo[a][c] : NULL, &ne->ctx.axis[a]);
                 }
             }
         } else {
@@ -171,6 +176,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                 if (!h[c]) continue;
                 entry *ne = &stack[sp++];
                 ne->leaf = ch[c].leaf;
+                ne->ctx_ok = 0; /* from the unit: checked when popped */
                 ne->ptr = ch[c].ptr;
                 for (int a = 0; a < 3; a++) ne->ctx.axis[a] = cbvh_axis_child_ctx(&ctx.axis[a], &ch[c].axis[a]);
                 ne->t_near = tn[c];

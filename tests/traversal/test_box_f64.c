@@ -373,7 +373,12 @@ static void test_pair_decode(void) {
                 cbvh_rbf_axis ax = cbvh_rbf_axis_prep(ctx.axis[a].clb, ctx.axis[a].scale);
                 double plo = ax.u + (double)fc[c].r[a] * ax.step;
                 cbvh_axis_ctx want = cbvh_axis_child_ctx(&ctx.axis[a], &ch[c].axis[a]), got;
-                cbvh_fast_child_ctx(&p, enc, &ctx.axis[a], &fc[c], a, ax.exact ? &plo : NULL, &got);
+                cbvh_fast_child_ctx(&p, enc, &ctx.axis[a], cbvh_fast_pmod(&p, &ctx.axis[a]), &fc[c], a,
+                                    ax.exact ? &plo : NULL, &got);
+                /* the traversal trusts derived contexts without checking them again */
+                if (!cbvh_fast_ctx_ok(&p, &got)) {
+                    if (failures++ < 10) printf("FAIL pair %ld child %d axis %d: derived context invalid\n", i, c, a);
+                }
                 if (r != fc[c].r[a] || s != fc[c].s[a] || memcmp(&want, &got, sizeof want)) {
                     if (failures++ < 10)
                         printf("FAIL pair %ld child %d axis %d: r %u/%u s %u/%u ctx (%d %d %u %08x)/(%d %d %u %08x)\n", i,
