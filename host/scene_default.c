@@ -8,7 +8,6 @@
 #include <cjson/cJSON.h>
 
 #include "scene_file.h"
-#include "scene_load.h"
 
 static int has_suffix(const char *s, const char *suf) {
     size_t n = strlen(s), m = strlen(suf);
@@ -25,35 +24,26 @@ static cJSON *vec3(float x, float y, float z) {
 }
 
 int cbvh_scene_file_default(const char *mesh, cbvh_scene_desc *d, char *err, size_t errlen) {
-    memset(d, 0, sizeof *d);
-    cbvh_scene s;
-    if (cbvh_scene_open(mesh, &s, err, errlen)) return -1;
-    float lo[3], hi[3], c[3], ext = 0;
-    cbvh_scene_bounds(&s, lo, hi);
-    cbvh_scene_free(&s);
-    for (int a = 0; a < 3; a++) {
-        c[a] = 0.5f * lo[a] + 0.5f * hi[a];
-        if (hi[a] - lo[a] > ext) ext = hi[a] - lo[a];
-    }
     /* The scene file's mesh path is looked up beside the file; the "file"
-     * here is the mesh itself, so name it by its last path component. */
+     * here is the mesh itself, so name it by its last path component.  The
+     * camera, light and AO distance depend on the mesh's box: placeholders
+     * here, set below from the mesh the parser has loaded (loaded once). */
     const char *slash = strrchr(mesh, '/');
     const char *name = strncmp(mesh, "proc:", 5) == 0 || !slash ? mesh : slash + 1;
     cJSON *root = cJSON_CreateObject(), *cam = cJSON_CreateObject(), *lights = cJSON_CreateArray();
     cJSON *light = cJSON_CreateObject(), *mats = cJSON_CreateArray(), *mat = cJSON_CreateObject();
     cJSON *floor_ = cJSON_CreateObject(), *fx = cJSON_CreateArray(), *ao = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "mesh", name);
-    /* camera above and in front of the centre, looking at it (y up) */
     cJSON_AddStringToObject(cam, "type", "pinhole");
     cJSON_AddNumberToObject(cam, "width", 256);
     cJSON_AddNumberToObject(cam, "height", 192);
-    cJSON_AddItemToObject(cam, "position", vec3(c[0] + 0.45f * ext, c[1] + 0.35f * ext, c[2] + 1.9f * ext));
-    cJSON_AddItemToObject(cam, "target", vec3(c[0], c[1], c[2]));
+    cJSON_AddItemToObject(cam, "position", vec3(0, 0, 1));
+    cJSON_AddItemToObject(cam, "target", vec3(0, 0, 0));
     cJSON_AddItemToObject(cam, "up", vec3(0, 1, 0));
     cJSON_AddNumberToObject(cam, "fov", 35);
     cJSON_AddItemToObject(root, "camera", cam);
     cJSON_AddStringToObject(light, "type", "point");
-    cJSON_AddItemToObject(light, "position", vec3(c[0] + ext, c[1] + 2 * ext, c[2] + ext));
+    cJSON_AddItemToObject(light, "position", vec3(0, 0, 0));
     cJSON_AddItemToArray(lights, light);
     cJSON_AddItemToObject(root, "lights", lights);
     cJSON_AddStringToObject(mat, "name", "diffuse");
@@ -68,19 +58,41 @@ int cbvh_scene_file_default(const char *mesh, cbvh_scene_desc *d, char *err, siz
     cJSON_AddItemToArray(fx, cJSON_CreateString("hard_shadows"));
     cJSON_AddStringToObject(ao, "effect", "ambient_occlusion");
     cJSON_AddNumberToObject(ao, "samples", 2);
-    cJSON_AddNumberToObject(ao, "distance", 0.2 * ext);
     cJSON_AddItemToArray(fx, ao);
     cJSON_AddItemToObject(root, "effects", fx);
     cJSON_AddNumberToObject(root, "seed", 1);
     char *text = cJSON_PrintUnformatted(root);
     cJSON_Delete(root);
     if (!text) {
+        memset(d, 0, sizeof *d);
         snprintf(err, errlen, "%s: cannot form its default scene (out of memory)", mesh);
         return -1;
     }
     int rc = cbvh_scene_file_parse(text, mesh, d, err, errlen);
     cJSON_free(text);
-    return rc;
+    if (rc) return -1;
+    /* the mesh's own box (the floor follows its triangles) */
+    cbvh_scene m = d->mesh;
+    m.ntris = d->mesh_tris;
+    float lo[3], hi[3], c[3], ext = 0;
+    cbvh_scene_bounds(&m, lo, hi);
+    for (int a = 0; a < 3; a++) {
+        c[a] = 0.5f * lo[a] + 0.5f * hi[a];
+        if (hi[a] - lo[a] > ext) ext = hi[a] - lo[a];
+    }
+    if (!(ext > 0)) { /* a point or empty mesh: no view direction */
+        snprintf(err, errlen, "%s: the mesh has no extent; no default camera", mesh);
+        cbvh_scene_desc_free(d);
+        return -1;
+    }
+    const float cam_off[3] = {0.45f, 0.35f, 1.9f}, light_off[3] = {1, 2, 1};
+    for (int a = 0; a < 3; a++) {
+        d->camera.position[a] = c[a] + cam_off[a] * ext;
+        d->camera.target[a] = c[a];
+        d->lights[0].position[a] = c[a] + light_off[a] * ext;
+    }
+    d->effect[CBVH_FX_AMBIENT_OCCLUSION].distance = 0.2f * ext;
+    return 0;
 }
 
 int cbvh_scene_file_open(const char *arg, cbvh_scene_desc *d, char *err, size_t errlen) {

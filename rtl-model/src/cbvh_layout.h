@@ -36,13 +36,17 @@ static inline void cbvh_tree_put_ids(cbvh_tree *t, const cbvh_bvh *b, const cbvh
 
 /* cbvh_f32_of, cbvh_float_of: cbvh/fp32.h */
 
-/* Node-pair input for float node c. */
-static inline void cbvh_child_from_node(const cbvh_bvh *b, const cbvh_layout *l, uint32_t c, cbvh_child_in *in) {
-    const cbvh_bvh_node *n = &b->nodes[c];
+/* Node-pair input for float node n whose slot is `slot`. */
+static inline void cbvh_child_in_of(const cbvh_bvh_node *n, uint32_t slot, cbvh_child_in *in) {
     for (int a = 0; a < 3; a++) in->lo[a] = cbvh_f32_of(n->lo[a]), in->hi[a] = cbvh_f32_of(n->hi[a]);
     in->leaf = cbvh_bvh_is_leaf(n);
     in->empty = 0;
-    in->ptr = l->slot[c];
+    in->ptr = slot;
+}
+
+/* The same for float node c of b, its slot from the layout. */
+static inline void cbvh_child_from_node(const cbvh_bvh *b, const cbvh_layout *l, uint32_t c, cbvh_child_in *in) {
+    cbvh_child_in_of(&b->nodes[c], l->slot[c], in);
 }
 
 /* Inputs of the pair of node x (inner: its two children; a leaf root: the

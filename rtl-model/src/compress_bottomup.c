@@ -326,14 +326,6 @@ void cbvh_bu_close(cbvh_bu_stream *s) {
     free(s);
 }
 
-/* Node-pair input for a float node with slot `slot`. */
-static void child_in(const cbvh_bvh_node *n, uint32_t slot, cbvh_child_in *in) {
-    for (int a = 0; a < 3; a++) in->lo[a] = cbvh_f32_of(n->lo[a]), in->hi[a] = cbvh_f32_of(n->hi[a]);
-    in->leaf = cbvh_bvh_is_leaf(n);
-    in->empty = 0;
-    in->ptr = slot;
-}
-
 /* The step of Algorithm 1 for node n into pair `pair`: an inner node with
  * children cn[0], cn[1] (slots slot[0], slot[1]; their records, if inner, on
  * top of the context stack), or with cn == NULL a leaf root (slot[0] its
@@ -412,10 +404,10 @@ general:;
     cbvh_child_out co[2];
     memset(in, 0, sizeof in);
     if (leaf) {
-        child_in(n, slot[0], &in[0]);
+        cbvh_child_in_of(n, slot[0], &in[0]);
         in[1].empty = 1;
     } else {
-        for (int c = 0; c < 2; c++) child_in(cn_in[c], slot[c], &in[c]);
+        for (int c = 0; c < 2; c++) cbvh_child_in_of(cn_in[c], slot[c], &in[c]);
     }
     st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
     if (st & ENC_FAIL) {

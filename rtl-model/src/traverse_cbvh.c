@@ -41,8 +41,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     memset(hit, 0, sizeof *hit);
     /* the ray check of trav_ray_ok, without preparing the ray */
     if (cbvh_rb_ray_status(ray, mant_bits)) return -1;
-    ts.ray = ray;
-    cbvh_tri_ray_prepare(ray, &ts.tprep);
+    trav_set_ray(&ts, ray);
     ts.tris = tris;
     ts.mode = mode;
     ts.M = mant_bits;

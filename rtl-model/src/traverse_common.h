@@ -13,7 +13,7 @@
 typedef struct {
     const cbvh_ray *ray;
     cbvh_rb_ray prep; /* the ray prepared once for the box unit's fast path */
-    cbvh_tri_ray tprep; /* ... and for the triangle unit's filter (trav_prepare_tri) */
+    cbvh_tri_ray tprep; /* ... and for the triangle unit's filter (trav_set_ray) */
     const cbvh_tri *tris;
     cbvh_trav_mode mode;
     int M;
@@ -22,6 +22,12 @@ typedef struct {
     cbvh_trav_stats s;
     int done; /* any-hit found */
 } trav_state;
+
+/* The ray, and its preparation for the triangle unit (every traversal). */
+static inline void trav_set_ray(trav_state *ts, const cbvh_ray *ray) {
+    ts->ray = ray;
+    cbvh_tri_ray_prepare(ray, &ts->tprep);
+}
 
 static inline uint64_t trav_align(uint64_t a) { return (a + CBVH_LINE_BYTES - 1) / CBVH_LINE_BYTES * CBVH_LINE_BYTES; }
 

@@ -53,8 +53,7 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
         cbvh_rb_prepare(ray, &qs.prep);
         if (cbvh_ray_box_float_prep(&qs.prep, ray->tmax, mant_bits, z, z, &r) != 0) return -1;
     }
-    qs.ray = ray;
-    cbvh_tri_ray_prepare(ray, &qs.tprep);
+    trav_set_ray(&qs, ray);
     qs.tris = tris;
     qs.mode = mode;
     qs.M = mant_bits;

@@ -21,8 +21,7 @@ int cbvh_trace_tlist(const cbvh_tlists *L, int l, uint32_t head, const cbvh_tri 
     memset(hit, 0, sizeof *hit);
     if (l < 0 || l >= L->p.nlists || l >= CBVH_TLIST_MAX || head > L->len[l]) return -1;
     if (!trav_ray_ok(&ts, ray, CBVH_MANT_MAX)) return -1;
-    ts.ray = ray;
-    cbvh_tri_ray_prepare(ray, &ts.tprep);
+    trav_set_ray(&ts, ray);
     ts.tris = tris;
     ts.mode = mode;
     ts.M = CBVH_MANT_MAX;
