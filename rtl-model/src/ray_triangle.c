@@ -9,6 +9,7 @@
  * needed), which is what the fallback approximates: the edge functions' signs
  * are exact, so a ray through a shared edge or vertex of a closed mesh always
  * hits at least one of the adjacent triangles.  Integer-only. */
+#include <math.h>
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
@@ -130,7 +131,7 @@ uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3],
  * bounds' own rounding, so the bounds also hold if the compiler contracts
  * (the file is compiled with -ffp-contract=off anyway, so the filter's
  * decisions are reproducible). */
-static double dabs(double x) { return x < 0 ? -x : x; }
+static double dabs(double x) { return fabs(x); } /* one AND of the sign bit */
 static double f32d(cbvh_f32 b) {
     float f;
     memcpy(&f, &b, sizeof f);

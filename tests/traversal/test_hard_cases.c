@@ -223,6 +223,7 @@ typedef struct {
 typedef struct {
     cbvh_scene s;
     cbvh_bvh b[2];
+    cbvh_fbvh fb[2]; /* b[i] laid out for the plain float traversal */
     const char *bname[2];
     int nb;
     tree_cfg tr[MAX_TREES];
@@ -264,6 +265,11 @@ static int world_build(world *w, const tcfg *cfg, int ncfg, int both_builders) {
         }
         w->bname[w->nb++] = "lbvh";
     }
+    for (int bi = 0; bi < w->nb; bi++)
+        if (cbvh_fbvh_build(&w->b[bi], &w->fb[bi], err, sizeof err)) {
+            FAIL("float BVH layout: %s", err);
+            return -1;
+        }
     w->nt = 0;
     for (int bi = 0; bi < w->nb; bi++)
         for (int c = 0; c < ncfg && w->nt < MAX_TREES; c++) {
@@ -293,7 +299,10 @@ static int world_build(world *w, const tcfg *cfg, int ncfg, int both_builders) {
 
 static void world_free(world *w) {
     for (int i = 0; i < w->nt; i++) cbvh_tree_free(&w->tr[i].t);
-    for (int i = 0; i < w->nb; i++) cbvh_bvh_free(&w->b[i]);
+    for (int i = 0; i < w->nb; i++) {
+        cbvh_fbvh_free(&w->fb[i]);
+        cbvh_bvh_free(&w->b[i]);
+    }
     cbvh_scene_free(&w->s);
 }
 
@@ -333,6 +342,23 @@ static cbvh_trav_hit check_ray(world *w, const cbvh_ray *r, int use_brute) {
         }
         if (!any_ok(w, r, &any, ref.hit)) {
             FAIL("float BVH %s any-hit %d prim %u, reference hit %d", w->bname[bi], any.hit, any.prim, ref.hit);
+            print_ray("", r);
+        }
+        /* the plain floating-point traversal of the same BVH */
+        if (cbvh_trace_bvh_float(&w->fb[bi], w->s.tris, r, CBVH_TRAV_CLOSEST, &h, &st) ||
+            cbvh_trace_bvh_float(&w->fb[bi], w->s.tris, r, CBVH_TRAV_ANY, &any, &st)) {
+            FAIL("plain float BVH %s rejected a valid ray", w->bname[bi]);
+            print_ray("", r);
+            continue;
+        }
+        w->checks++;
+        if (!same_hit(&h, &ref)) {
+            FAIL("plain float BVH %s closest hit %d prim %u t %08X != reference hit %d prim %u t %08X", w->bname[bi],
+                 h.hit, h.prim, h.t, ref.hit, ref.prim, ref.t);
+            print_ray("", r);
+        }
+        if (!any_ok(w, r, &any, ref.hit)) {
+            FAIL("plain float BVH %s any-hit %d prim %u, reference hit %d", w->bname[bi], any.hit, any.prim, ref.hit);
             print_ray("", r);
         }
     }
@@ -1058,6 +1084,13 @@ static int case_nan_inf_rays(void) {
                     all_rejected = 0;
                     FAIL("nan_inf_rays: float BVH (mode %d) rc %d hit %d box %llu tri %llu", mode, rc, h.hit,
                          (unsigned long long)ts.box_tests, (unsigned long long)ts.tri_tests);
+                    print_ray("", &r);
+                }
+                memset(&h, 0xAB, sizeof h);
+                rc = cbvh_trace_bvh_float(&w.fb[0], w.s.tris, &r, (cbvh_trav_mode)mode, &h, &ts);
+                if (rc != -1 || h.hit || h.prim || h.t || ts.box_tests || ts.tri_tests || ts.nodes || ts.bytes) {
+                    all_rejected = 0;
+                    FAIL("nan_inf_rays: plain float BVH (mode %d) rc %d hit %d", mode, rc, h.hit);
                     print_ray("", &r);
                 }
                 for (int t = 0; t < w.nt; t++) {

@@ -6,13 +6,18 @@
  * over >= 1M structured and random inputs (hard cases: axis-parallel rays with
  * +0/-0 components, origins on faces and inside, grazing rays along faces,
  * rays aimed at corners, -2^128 lower bounds, huge scales), every M in 3..24.
- * Plus NaN/Inf/zero-direction rejects and the float-plane variant. */
+ * Plus NaN/Inf/zero-direction rejects and the float-plane variant, and the
+ * plain floating-point traversal's binary64 box test (ray_box_ref.h,
+ * docs/traversal.md §11) on every input whose planes are binary32: never a
+ * false miss, t_lo <= the exact near t. */
 #include <gmp.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
+#include "ray_box_ref.h"
 #include "test_util.h"
 
 #ifdef CBVH_SANITIZE
@@ -93,6 +98,20 @@ static void q_step(mpq_t out, cbvh_f32 x, int M, int up) {
 }
 
 static long n_hit, n_exact_hit, failures;
+static long n_ref_checked, n_ref_exact_hit, n_ref_hit;
+
+/* Plane u + c 2^e as a binary32 when it is one exactly (1), else 0. */
+static int plane_f32(const cbvh_grid_axis *g, uint32_t c, cbvh_f32 *out) {
+    if (g->u == CBVH_F32_NEG_INF) return 0;
+    int s, e;
+    uint32_t sig;
+    cbvh_f32_break(g->u, &s, &sig, &e);
+    cbvh_f32 dn = cbvh_f32_add_dyadic(s ? -(int64_t)sig : (int64_t)sig, e, (int64_t)c, g->e, CBVH_RND_DOWN);
+    cbvh_f32 up = cbvh_f32_add_dyadic(s ? -(int64_t)sig : (int64_t)sig, e, (int64_t)c, g->e, CBVH_RND_UP);
+    if (dn != up || cbvh_f32_is_nan_or_inf(dn)) return 0;
+    *out = dn;
+    return 1;
+}
 static long n_tight_checked;
 
 static void fail(const char *what, const cbvh_ray *r, int M, const cbvh_grid_axis *g) {
@@ -144,6 +163,36 @@ static void check(const cbvh_ray *ray, int M, const cbvh_grid_axis g[3]) {
     }
     if (hit && !far_inf && mpq_cmp(tn, tf) > 0) hit = 0;
     n_exact_hit += hit;
+    /* the plain float traversal's box test on the same planes, as both children */
+    float box[12];
+    int planes_ok = 1;
+    for (int a = 0; a < 3; a++) {
+        cbvh_f32 l, h;
+        planes_ok &= plane_f32(&g[a], g[a].r, &l) && plane_f32(&g[a], g[a].s, &h);
+        if (!planes_ok) break;
+        for (int c = 0; c < 2; c++) {
+            box[CBVH_REF_AT(0, a, c)] = bf(l);
+            box[CBVH_REF_AT(1, a, c)] = bf(h);
+        }
+    }
+    if (planes_ok) {
+        cbvh_ref_ray rr;
+        cbvh_ref_prepare(ray, &rr);
+        int rh[2];
+        double tl[2];
+        double cull = cbvh_float_of(ray->tmax);
+        if (rr.general) cbvh_ref_box2_any(&rr, box, cull, rh, tl);
+        else cbvh_ref_box2(&rr, box, cull, rh, tl);
+        n_ref_checked++;
+        n_ref_exact_hit += hit;
+        n_ref_hit += rh[0];
+        if (rh[0] != rh[1] || (rh[0] && tl[0] != tl[1])) fail("plain float box: lanes differ", ray, M, g);
+        if (hit && !rh[0]) fail("plain float box: false miss", ray, M, g);
+        if (hit && rh[0]) {
+            mpq_set_d(t, tl[0]);
+            if (mpq_cmp(t, tn) > 0) fail("plain float box: t_lo above exact near", ray, M, g);
+        }
+    }
     n_hit += res.hit;
     if (hit && !res.hit) fail("false miss", ray, M, g);
     if (res.hit) {
@@ -244,6 +293,113 @@ static void random_case(int M) {
     check(&r, M, g);
 }
 
+/* The plain float box test on a binary32 box [lo, hi] against the exact slab
+ * test: never a false miss, t_lo <= the exact near t. */
+static void check_ref_float(const cbvh_ray *ray, const cbvh_f32 lo[3], const cbvh_f32 hi[3], cbvh_f32 lo1) {
+    mpq_t ql, qh, o, d, tn, tf, n, f;
+    mpq_inits(ql, qh, o, d, tn, tf, n, f, NULL);
+    int far_inf = ray->tmax == CBVH_F32_POS_INF, hit = 1;
+    q_f32(tn, ray->tmin);
+    if (!far_inf) q_f32(tf, ray->tmax);
+    for (int a = 0; a < 3 && hit; a++) {
+        q_f32(ql, lo[a]);
+        q_f32(qh, hi[a]);
+        q_f32(o, ray->o[a]);
+        if (cbvh_f32_is_zero(ray->d[a])) {
+            if (mpq_cmp(o, ql) < 0 || mpq_cmp(o, qh) > 0) hit = 0;
+            continue;
+        }
+        q_f32(d, ray->d[a]);
+        int neg = mpq_sgn(d) < 0;
+        mpq_sub(n, neg ? qh : ql, o);
+        mpq_div(n, n, d);
+        mpq_sub(f, neg ? ql : qh, o);
+        mpq_div(f, f, d);
+        if (mpq_cmp(n, tn) > 0) mpq_set(tn, n);
+        if (far_inf || mpq_cmp(f, tf) < 0) {
+            mpq_set(tf, f);
+            far_inf = 0;
+        }
+    }
+    if (hit && !far_inf && mpq_cmp(tn, tf) > 0) hit = 0;
+    /* child 0 is the box, child 1 the same box with lo_x = lo1 (<= lo_x: a superset) */
+    float box[12];
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 2; c++) {
+            box[CBVH_REF_AT(0, a, c)] = bf(a == 0 && c == 1 ? lo1 : lo[a]);
+            box[CBVH_REF_AT(1, a, c)] = bf(hi[a]);
+        }
+    cbvh_ref_ray rr;
+    cbvh_ref_prepare(ray, &rr);
+    int rh[2];
+    double tl[2];
+    double cull = cbvh_float_of(ray->tmax);
+    if (rr.general) cbvh_ref_box2_any(&rr, box, cull, rh, tl);
+    else cbvh_ref_box2(&rr, box, cull, rh, tl);
+    /* the general variant is conservative for every ray */
+    int gh[2];
+    double gl[2];
+    cbvh_ref_box2_any(&rr, box, cull, gh, gl);
+    n_ref_checked++;
+    n_ref_exact_hit += hit;
+    n_ref_hit += rh[0];
+    cbvh_grid_axis none[3] = {{0, 0, 0, 1}, {0, 0, 0, 1}, {0, 0, 0, 1}};
+    if (hit && (!rh[0] || !rh[1] || !gh[0] || !gh[1])) fail("plain float box: false miss (float box)", ray, 24, none);
+    if (hit) {
+        mpq_set_d(n, tl[0]);
+        if (mpq_cmp(n, tn) > 0) fail("plain float box: t_lo above exact near (float box)", ray, 24, none);
+        mpq_set_d(n, gl[0]);
+        if (mpq_cmp(n, tn) > 0) fail("plain float box: general t_lo above exact near", ray, 24, none);
+    }
+    mpq_clears(ql, qh, o, d, tn, tf, n, f, NULL);
+}
+
+/* A random binary32 box and a ray that often starts on its faces, inside it,
+ * grazes a face or is aimed at a corner; extreme and subnormal values,
+ * +0 / -0 direction components. */
+static void random_float_box(void) {
+    cbvh_f32 lo[3], hi[3];
+    cbvh_ray r;
+    for (int a = 0; a < 3; a++) {
+        cbvh_f32 x = rfloat(), y = below(4) ? rfloat() : x; /* sometimes flat */
+        if (cbvh_f32_key(x) > cbvh_f32_key(y)) {
+            cbvh_f32 t = x;
+            x = y;
+            y = t;
+        }
+        lo[a] = x;
+        hi[a] = y;
+    }
+    int kind = (int)below(6);
+    for (int a = 0; a < 3; a++) {
+        r.o[a] = kind == 0 ? (below(2) ? lo[a] : hi[a]) : rfloat();
+        r.d[a] = rfloat();
+        if (below(6) == 0) r.d[a] = below(2) ? 0 : CBVH_F32_SIGN;
+    }
+    if (kind == 1) { /* grazing: parallel to an axis, on a face of it */
+        int a = (int)below(3);
+        r.d[a] = below(2) ? 0 : CBVH_F32_SIGN;
+        r.o[a] = below(2) ? lo[a] : hi[a];
+    }
+    if (kind == 2) /* aimed at a corner: d = corner - o, rounded */
+        for (int a = 0; a < 3; a++) {
+            float dd = bf(below(2) ? lo[a] : hi[a]) - bf(r.o[a]);
+            r.d[a] = isfinite(dd) ? fb(dd) : 0x3F800000u;
+        }
+    if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[0] = 0x3F800000u;
+    int tk = (int)below(4);
+    r.tmin = tk == 0 ? rfloat() : 0;
+    r.tmax = tk <= 1 ? CBVH_F32_POS_INF : rfloat();
+    if (tk == 3 && cbvh_f32_key(r.tmax) < cbvh_f32_key(r.tmin)) {
+        cbvh_f32 x = r.tmin;
+        r.tmin = r.tmax;
+        r.tmax = x;
+    }
+    cbvh_f32 lo1 = below(2) ? lo[0] : rfloat();
+    if (cbvh_f32_key(lo1) > cbvh_f32_key(lo[0])) lo1 = lo[0];
+    check_ref_float(&r, lo, hi, lo1);
+}
+
 static void rejects(void) {
     cbvh_grid_axis g[3] = {{0, 0, 0, 1}, {0, 0, 0, 1}, {0, 0, 0, 1}};
     cbvh_ray r = {{0, 0, 0}, {0x3F800000u, 0, 0}, 0, CBVH_F32_POS_INF};
@@ -328,6 +484,14 @@ int main(void) {
     printf("ray_box: %ld inputs, M = %d..%d: exact hits %ld, unit hits %ld (conservative extra %ld), "
            "tightness checked %ld, failures %ld\n",
            total, CBVH_MANT_MIN, CBVH_MANT_MAX, n_exact_hit, n_hit, n_hit - n_exact_hit, n_tight_checked, failures);
+    for (long i = 0; i < N_CASES / 2; i++) random_float_box();
+    printf("plain float box test: %ld inputs with binary32 planes, exact hits %ld, its hits %ld\n", n_ref_checked,
+           n_ref_exact_hit, n_ref_hit);
+    if (n_ref_checked < N_CASES / 2 || n_ref_exact_hit < n_ref_checked / 20) {
+        fprintf(stderr, "FAIL: too few plain float box checks (%ld, %ld exact hits)\n", n_ref_checked,
+                n_ref_exact_hit);
+        return 1;
+    }
     if (n_exact_hit < total / 50) {
         fprintf(stderr, "FAIL: too few exact hits (%ld) for a meaningful test\n", n_exact_hit);
         return 1;

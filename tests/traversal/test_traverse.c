@@ -1,4 +1,7 @@
 /* Traversal core (docs/traversal.md §5) on real scenes:
+ *   - the plain floating-point traversal (§11) == float-BVH closest hit bit
+ *     for bit, same any-hit flag, same triangle-test rule, every box it
+ *     culls culled by the unit too (its box tests <= the unit's + 1 %);
  *   - CBVH closest hit == float-BVH closest hit (triangle id and t bit pattern)
  *     for every ray, at N = 3, 6, 10 (modulo) and N = 6 (relative), box unit
  *     M = 24 and M = 8;
@@ -48,8 +51,14 @@ static void run_scene(const char *spec) {
     int edge_on = strstr(spec, "cloth") != NULL;
     cbvh_ray *rays = malloc(RAYS * sizeof *rays);
     cbvh_trav_hit *ref = malloc(RAYS * sizeof *ref);
-    cbvh_trav_stats fs = {0}, fa = {0};
-    long hits = 0;
+    cbvh_trav_stats fs = {0}, fa = {0}, ps = {0}, pas = {0};
+    cbvh_fbvh fb;
+    if (cbvh_fbvh_build(&b, &fb, err, sizeof err)) {
+        fprintf(stderr, "FAIL layout %s: %s\n", spec, err);
+        failures++;
+        fb.nodes = NULL;
+    }
+    long hits = 0, plain_mismatch = 0;
     for (int i = 0; i < RAYS; i++) {
         rays[i] = box_ray(&rs, lo, hi, i, edge_on);
         cbvh_trav_hit any;
@@ -60,6 +69,12 @@ static void run_scene(const char *spec) {
         }
         hits += ref[i].hit;
         if (any.hit != ref[i].hit) failures++;
+        cbvh_trav_hit ph, pa;
+        if (!fb.nodes || cbvh_trace_bvh_float(&fb, s.tris, &rays[i], CBVH_TRAV_CLOSEST, &ph, &ps) ||
+            cbvh_trace_bvh_float(&fb, s.tris, &rays[i], CBVH_TRAV_ANY, &pa, &pas) || !same_hit(&ph, &ref[i]) ||
+            pa.hit != ref[i].hit) {
+            if (plain_mismatch++ < 3) fprintf(stderr, "FAIL %s ray %d: plain float BVH != float BVH\n", spec, i);
+        }
         if (i < BRUTE) {
             cbvh_trav_hit bf = brute(&s, &rays[i]);
             if (!same_hit(&bf, &ref[i])) {
@@ -71,6 +86,19 @@ static void run_scene(const char *spec) {
            "stack %u; any-hit %.1f box\n",
            spec, s.ntris, RAYS, hits, (double)fs.nodes / RAYS, (double)fs.box_tests / RAYS,
            (double)fs.tri_tests / RAYS, (double)fs.bytes / RAYS, fs.max_stack, (double)fa.box_tests / RAYS);
+    printf("%-22s %6u tris: plain float traversal closest: %.1f nodes %.1f box %.1f tri %.0f B/ray; "
+           "mismatches %ld\n",
+           spec, s.ntris, (double)ps.nodes / RAYS, (double)ps.box_tests / RAYS, (double)ps.tri_tests / RAYS,
+           (double)ps.bytes / RAYS, plain_mismatch);
+    failures += plain_mismatch;
+    /* conservative within binary64 error: at most a few more boxes than the exact M = 24 unit */
+    if (ps.box_tests > fs.box_tests + fs.box_tests / 100 || ps.box_tests < fs.box_tests / 2 ||
+        ps.bytes != ps.lines * CBVH_LINE_BYTES) {
+        fprintf(stderr, "FAIL %s: plain float box tests %llu vs unit %llu\n", spec, (unsigned long long)ps.box_tests,
+                (unsigned long long)fs.box_tests);
+        failures++;
+    }
+    if (fb.nodes) cbvh_fbvh_free(&fb);
     if (hits < RAYS / 10 || fs.box_tests < (uint64_t)RAYS) failures++;
     struct {
         int N, M;
@@ -146,6 +174,11 @@ static void bad_rays(void) {
             cbvh_trav_hit h;
             cbvh_trav_stats st = {0};
             if (cbvh_trace_bvh(&b, s.tris, &bad[i], 24, CBVH_TRAV_CLOSEST, &h, &st) != -1 || h.hit) failures++;
+            cbvh_fbvh fb;
+            if (cbvh_fbvh_build(&b, &fb, err, sizeof err) ||
+                cbvh_trace_bvh_float(&fb, s.tris, &bad[i], CBVH_TRAV_CLOSEST, &h, &st) != -1 || h.hit)
+                failures++;
+            cbvh_fbvh_free(&fb);
             if (cbvh_trace_cbvh(&t, s.tris, &bad[i], 24, CBVH_TRAV_CLOSEST, &h, &st) != -1 || h.hit) failures++;
             if (st.box_tests || st.tri_tests) failures++;
         }
@@ -156,8 +189,36 @@ static void bad_rays(void) {
     cbvh_scene_free(&s);
 }
 
+/* The plain traversal's layout refuses what is not a tree, with a reason. */
+static void bad_layout(void) {
+    cbvh_bvh_node nodes[3] = {{{0, 0, 0}, {1, 1, 1}, {1, 2}, 0, 0},
+                              {{0, 0, 0}, {1, 1, 1}, {0, 0}, 0, 1},
+                              {{0, 0, 0}, {1, 1, 1}, {0, 0}, 1, 1}};
+    uint32_t prims[2] = {0, 1};
+    cbvh_bvh b = {nodes, 3, 0, prims, 2};
+    cbvh_fbvh f;
+    char err[256] = "";
+    if (cbvh_fbvh_build(&b, &f, err, sizeof err) || f.nnodes != 1 || f.root != 0 ||
+        f.nodes[0].child[1] != (CBVH_FBVH_LEAF | 1u) || f.nodes[0].node[1] != 1) {
+        fprintf(stderr, "FAIL layout of a 3-node tree: %s\n", err);
+        failures++;
+    }
+    cbvh_fbvh_free(&f);
+    nodes[0].child[1] = 0; /* a cycle */
+    if (cbvh_fbvh_build(&b, &f, err, sizeof err) != -1 || !strstr(err, "not a tree") || f.nodes) {
+        fprintf(stderr, "FAIL cyclic BVH accepted by the layout (%s)\n", err);
+        failures++;
+    }
+    nodes[0].child[1] = 7; /* out of range */
+    if (cbvh_fbvh_build(&b, &f, err, sizeof err) != -1 || !strstr(err, "not a tree")) {
+        fprintf(stderr, "FAIL out-of-range child accepted by the layout (%s)\n", err);
+        failures++;
+    }
+}
+
 int main(void) {
     bad_rays();
+    bad_layout();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
     run_scene("proc:far:8");
     run_scene("proc:cloth:24");

@@ -1,10 +1,12 @@
 /* Traversal core: closest-hit and any-hit over the float BVH (reference) and
  * the CBVH (decoding node pairs with the datapath units on the way), using
- * the bit-exact ray-box and ray-triangle units, with per-ray counters.
- * Spec: docs/traversal.md §5. */
+ * the bit-exact ray-box and ray-triangle units, with per-ray counters; and a
+ * plain floating-point traversal of the float BVH for speed comparisons.
+ * Spec: docs/traversal.md §5, §11. */
 #ifndef CBVH_TRAVERSE_H
 #define CBVH_TRAVERSE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "cbvh/bvh.h"
@@ -54,6 +56,41 @@ int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray,
                    cbvh_trav_hit *hit, cbvh_trav_stats *st);
 int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
                     cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st);
+
+/* The float BVH laid out for the plain floating-point traversal (what a
+ * software renderer builds from it, as Embree builds its own): one 64-byte
+ * record per inner node with both children's boxes, so one line is read per
+ * node visited.  Records are in the BVH's depth-first order. */
+#define CBVH_FBVH_LEAF 0x80000000u /* child entry of a leaf */
+typedef struct {
+    float box[12];       /* ((plane * 3) + axis) * 2 + child, plane 0 = lo, 1 = hi */
+    uint32_t child[2];   /* inner child: record index; leaf: CBVH_FBVH_LEAF | its first primitive */
+    uint32_t node[2];    /* inner child: its node index in the float BVH (the counters' address);
+                          * leaf: its primitive count */
+} cbvh_fbvh_node;
+
+typedef struct {
+    const cbvh_bvh *bvh; /* not owned: leaves, primitive IDs and the counters' addresses */
+    cbvh_fbvh_node *nodes; /* 64-byte aligned */
+    uint32_t nnodes;
+    uint32_t root, root_node; /* the root as a child entry (child[], node[]) */
+    float root_box[12];  /* the root's box as child 0 (child 1 a copy) */
+} cbvh_fbvh;
+
+/* 0, or -1 with a one-line reason (out of memory, not a tree, more than 2^31
+ * nodes or primitives).  f->bvh points to b, which must outlive f. */
+int cbvh_fbvh_build(const cbvh_bvh *b, cbvh_fbvh *out, char *err, size_t errlen);
+void cbvh_fbvh_free(cbvh_fbvh *f);
+
+/* Plain floating-point traversal of the float BVH (docs/traversal.md §11):
+ * a conservative binary64 slab test (never a false miss) instead of the M-bit
+ * box unit, the ray-triangle unit for triangles.  Same hit rules and counters
+ * as cbvh_trace_bvh (addresses of the float BVH's own nodes), so the closest
+ * hit is the same bit for bit and the any-hit flag the same; box tests and
+ * visiting order are its own.  The software baseline a renderer would use;
+ * 0, or -1 (stack overflow, a ray the units reject). */
+int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
+                         cbvh_trav_hit *hit, cbvh_trav_stats *st);
 
 /* Lines covered by [addr, addr + size). */
 static inline uint64_t cbvh_lines_touched(uint64_t addr, uint64_t size) {

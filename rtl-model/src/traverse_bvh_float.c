@@ -1,0 +1,179 @@
+/* Plain floating-point traversal over the float BVH (docs/traversal.md §11):
+ * what a software renderer does, not a model of the accelerator's box unit.
+ * Boxes are tested with a conservative binary64 slab test (ray_box_ref.h:
+ * every rounding error bounded, never a false miss), triangles with the
+ * ray-triangle unit, so its hits are the units' hits bit for bit. */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "ray_box_ref.h"
+#include "traverse_common.h"
+
+_Static_assert(sizeof(cbvh_fbvh_node) == 64, "one record per 64-byte line");
+
+static void set_box(float box[12], int c, const cbvh_bvh_node *n) {
+    for (int a = 0; a < 3; a++) {
+        box[CBVH_REF_AT(0, a, c)] = n->lo[a];
+        box[CBVH_REF_AT(1, a, c)] = n->hi[a];
+    }
+}
+
+/* A child's entry: its record, or for a leaf CBVH_FBVH_LEAF | first with the
+ * leaf's count in the node word. */
+static void set_child(cbvh_fbvh_node *r, int c, const cbvh_bvh *b, uint32_t node, const uint32_t *rec) {
+    const cbvh_bvh_node *n = &b->nodes[node];
+    r->child[c] = cbvh_bvh_is_leaf(n) ? CBVH_FBVH_LEAF | n->first : rec[node];
+    r->node[c] = cbvh_bvh_is_leaf(n) ? n->count : node;
+}
+
+int cbvh_fbvh_build(const cbvh_bvh *b, cbvh_fbvh *out, char *err, size_t errlen) {
+    memset(out, 0, sizeof *out);
+    out->bvh = b;
+    if (b->nnodes >= CBVH_FBVH_LEAF || b->nprims >= CBVH_FBVH_LEAF) {
+        snprintf(err, errlen, "float BVH: %u nodes, %u primitives; at most %u supported", b->nnodes, b->nprims,
+                 CBVH_FBVH_LEAF - 1u);
+        return -1;
+    }
+    uint32_t *rec = malloc((size_t)b->nnodes * sizeof *rec);
+    uint32_t *stack = malloc(((size_t)b->nnodes + 1) * sizeof *stack);
+    size_t bytes = ((size_t)b->nnodes * sizeof(cbvh_fbvh_node) + 63u) / 64u * 64u;
+    out->nodes = aligned_alloc(64, bytes ? bytes : 64);
+    if (!rec || !stack || !out->nodes) {
+        free(rec);
+        free(stack);
+        cbvh_fbvh_free(out);
+        snprintf(err, errlen, "float BVH layout: out of memory (%u nodes)", b->nnodes);
+        return -1;
+    }
+    /* record numbers in depth-first order (child 0 first); a tree has at
+     * most nnodes reachable nodes, so more visits mean a cycle or sharing */
+    uint32_t sp = 0, n = 0, visits = 0;
+    stack[sp++] = b->root;
+    while (sp) {
+        uint32_t i = stack[--sp];
+        if (i >= b->nnodes || ++visits > b->nnodes) {
+            free(rec);
+            free(stack);
+            cbvh_fbvh_free(out);
+            snprintf(err, errlen, "float BVH: not a tree (node %u out of range or reached twice)", i);
+            return -1;
+        }
+        const cbvh_bvh_node *nd = &b->nodes[i];
+        if (cbvh_bvh_is_leaf(nd)) continue;
+        rec[i] = n++;
+        stack[sp++] = nd->child[1];
+        stack[sp++] = nd->child[0];
+    }
+    out->nnodes = n;
+    sp = 0;
+    stack[sp++] = b->root;
+    while (sp) {
+        uint32_t i = stack[--sp];
+        const cbvh_bvh_node *nd = &b->nodes[i];
+        if (cbvh_bvh_is_leaf(nd)) continue;
+        cbvh_fbvh_node *r = &out->nodes[rec[i]];
+        for (int c = 0; c < 2; c++) {
+            set_box(r->box, c, &b->nodes[nd->child[c]]);
+            set_child(r, c, b, nd->child[c], rec);
+        }
+        stack[sp++] = nd->child[1];
+        stack[sp++] = nd->child[0];
+    }
+    cbvh_fbvh_node root;
+    set_child(&root, 0, b, b->root, rec);
+    out->root = root.child[0];
+    out->root_node = root.node[0];
+    set_box(out->root_box, 0, &b->nodes[b->root]);
+    set_box(out->root_box, 1, &b->nodes[b->root]);
+
+    free(rec);
+    free(stack);
+    return 0;
+}
+
+void cbvh_fbvh_free(cbvh_fbvh *f) {
+    free(f->nodes);
+    memset(f, 0, sizeof *f);
+}
+
+int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
+                         cbvh_trav_hit *hit, cbvh_trav_stats *st) {
+    const cbvh_bvh *b = f->bvh;
+    trav_state ts;
+    memset(&ts, 0, sizeof ts);
+    memset(hit, 0, sizeof *hit);
+    /* the rays the units reject (NaN/Inf, zero direction) */
+    if (cbvh_rb_ray_status(ray, CBVH_MANT_MAX)) return -1;
+    trav_set_ray(&ts, ray);
+    ts.tris = tris;
+    ts.mode = mode;
+    ts.ids_base = trav_align((uint64_t)b->nnodes * 64u);
+    ts.tris_base = trav_align(ts.ids_base + (uint64_t)b->nprims * 4u);
+    cbvh_ref_ray r;
+    cbvh_ref_prepare(ray, &r);
+
+    /* the stack holds child entries as in the records: a record index and its
+     * node index, or CBVH_FBVH_LEAF | first and the count */
+    struct {
+        uint32_t entry, node;
+        double t_lo; /* lower bound of its entry t */
+    } stack[CBVH_TRAV_STACK + 2];
+    int sp = 0;
+    uint32_t max_stack = 0;
+    uint64_t nodes = 0;
+    /* the same culling bound as cbvh_trace_bvh: no acceptable triangle culled */
+    double cull = cbvh_float_of(trav_box_tmax(&ts));
+    int h[2];
+    double tl[2];
+    ts.s.box_tests++;
+    cbvh_ref_box2_any(&r, f->root_box, cull, h, tl);
+    if (h[0]) {
+        stack[0].entry = f->root;
+        stack[0].node = f->root_node;
+        stack[0].t_lo = tl[0];
+        sp = max_stack = 1;
+    }
+    while (sp > 0) {
+        sp--;
+        if (stack[sp].t_lo > cull) continue; /* culled since it was pushed */
+        uint32_t e = stack[sp].entry, ni = stack[sp].node;
+        if (e & CBVH_FBVH_LEAF) {
+            uint32_t first = e & ~CBVH_FBVH_LEAF, count = ni;
+            trav_fetch(&ts, ts.ids_base + (uint64_t)first * 4u, (uint64_t)count * 4u);
+            for (uint32_t i = 0; i < count && !ts.done; i++) trav_triangle(&ts, b->prims[first + i]);
+            if (ts.done) break;
+            cull = cbvh_float_of(trav_box_tmax(&ts));
+            continue;
+        }
+        const cbvh_fbvh_node *n = &f->nodes[e];
+        nodes++; /* the float BVH's node ni: one line at ni * 64, two box tests */
+        if (r.general) cbvh_ref_box2_any(&r, n->box, cull, h, tl);
+        else cbvh_ref_box2(&r, n->box, cull, h, tl);
+        if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
+        /* push the farther child first so the nearer one is visited next;
+         * both slots are written, sp advances only past the hit ones (no
+         * unpredictable branches) */
+        int far = tl[1] < tl[0] ? 0 : 1;
+        for (int k = 0; k < 2; k++) {
+            int c = far ^ k;
+            stack[sp].entry = n->child[c];
+            stack[sp].node = n->node[c];
+            stack[sp].t_lo = tl[c];
+            sp += h[c];
+        }
+        if ((uint32_t)sp > max_stack) max_stack = (uint32_t)sp;
+        /* the next node's record, or the next leaf's primitive IDs */
+        if (sp > 0) {
+            uint32_t top = stack[sp - 1].entry;
+            if (top & CBVH_FBVH_LEAF) __builtin_prefetch(&b->prims[top & ~CBVH_FBVH_LEAF]);
+            else __builtin_prefetch(&f->nodes[top]);
+        }
+    }
+    ts.s.nodes += nodes;
+    ts.s.box_tests += 2 * nodes;
+    ts.s.lines += nodes;
+    ts.s.bytes += nodes * CBVH_LINE_BYTES;
+    ts.s.max_stack = max_stack;
+    trav_finish(&ts, hit, st);
+    return 0;
+}
