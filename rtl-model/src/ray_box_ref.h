@@ -99,4 +99,11 @@ static inline void cbvh_ref_box2_any(const cbvh_ref_ray *r, const float box[12],
     }
 }
 
+/* The variant the ray calls for. */
+static inline void cbvh_ref_box2_for(const cbvh_ref_ray *r, const float box[12], double cull, int hit[2],
+                                     double t_lo[2]) {
+    if (r->general) cbvh_ref_box2_any(r, box, cull, hit, t_lo);
+    else cbvh_ref_box2(r, box, cull, hit, t_lo);
+}
+
 #endif

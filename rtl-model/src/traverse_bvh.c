@@ -45,16 +45,7 @@ static int box(trav_state *ts, const cbvh_rbf_ray *fp, const cbvh_bvh_node *n, c
 int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits, cbvh_trav_mode mode,
                    cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     trav_state ts;
-    memset(&ts, 0, sizeof ts);
-    memset(hit, 0, sizeof *hit);
-    /* the ray check of trav_ray_ok, without preparing the ray */
-    if (cbvh_rb_ray_status(ray, mant_bits)) return -1;
-    trav_set_ray(&ts, ray);
-    ts.tris = tris;
-    ts.mode = mode;
-    ts.M = mant_bits;
-    ts.ids_base = trav_align((uint64_t)b->nnodes * 64u);
-    ts.tris_base = trav_align(ts.ids_base + (uint64_t)b->nprims * 4u);
+    if (trav_begin(&ts, hit, ray, mant_bits, tris, mode, (uint64_t)b->nnodes * 64u, b->nprims)) return -1;
     cbvh_rbf_ray fp;
     cbvh_rbf_prepare(ray, mant_bits, &fp);
 

@@ -100,15 +100,8 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
                          cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     const cbvh_bvh *b = f->bvh;
     trav_state ts;
-    memset(&ts, 0, sizeof ts);
-    memset(hit, 0, sizeof *hit);
-    /* the rays the units reject (NaN/Inf, zero direction) */
-    if (cbvh_rb_ray_status(ray, CBVH_MANT_MAX)) return -1;
-    trav_set_ray(&ts, ray);
-    ts.tris = tris;
-    ts.mode = mode;
-    ts.ids_base = trav_align((uint64_t)b->nnodes * 64u);
-    ts.tris_base = trav_align(ts.ids_base + (uint64_t)b->nprims * 4u);
+    /* the float BVH's memory image (§5), whatever layout is read */
+    if (trav_begin(&ts, hit, ray, CBVH_MANT_MAX, tris, mode, (uint64_t)b->nnodes * 64u, b->nprims)) return -1;
     cbvh_ref_ray r;
     cbvh_ref_prepare(ray, &r);
 
@@ -126,7 +119,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     int h[2];
     double tl[2];
     ts.s.box_tests++;
-    cbvh_ref_box2_any(&r, f->root_box, cull, h, tl);
+    cbvh_ref_box2_for(&r, f->root_box, cull, h, tl);
     if (h[0]) {
         stack[0].entry = f->root;
         stack[0].node = f->root_node;
@@ -147,8 +140,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
         }
         const cbvh_fbvh_node *n = &f->nodes[e];
         nodes++; /* the float BVH's node ni: one line at ni * 64, two box tests */
-        if (r.general) cbvh_ref_box2_any(&r, n->box, cull, h, tl);
-        else cbvh_ref_box2(&r, n->box, cull, h, tl);
+        cbvh_ref_box2_for(&r, n->box, cull, h, tl);
         if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
         /* push the farther child first so the nearer one is visited next;
          * both slots are written, sp advances only past the hit ones (no

@@ -37,16 +37,7 @@ static const cbvh_rb_ray *prep(trav_state *ts) {
 int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
                     cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     trav_state ts;
-    memset(&ts, 0, sizeof ts);
-    memset(hit, 0, sizeof *hit);
-    /* the ray check of trav_ray_ok, without preparing the ray */
-    if (cbvh_rb_ray_status(ray, mant_bits)) return -1;
-    trav_set_ray(&ts, ray);
-    ts.tris = tris;
-    ts.mode = mode;
-    ts.M = mant_bits;
-    ts.ids_base = trav_align((uint64_t)t->npairs * t->pair_bytes);
-    ts.tris_base = trav_align(ts.ids_base + (uint64_t)t->nids * 4u);
+    if (trav_begin(&ts, hit, ray, mant_bits, tris, mode, (uint64_t)t->npairs * t->pair_bytes, t->nids)) return -1;
     cbvh_rbf_ray fp;
     cbvh_rbf_prepare(ray, mant_bits, &fp);
     const cbvh_params *prm = &t->params;

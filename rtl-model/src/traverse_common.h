@@ -31,6 +31,24 @@ static inline void trav_set_ray(trav_state *ts, const cbvh_ray *ray) {
 
 static inline uint64_t trav_align(uint64_t a) { return (a + CBVH_LINE_BYTES - 1) / CBVH_LINE_BYTES * CBVH_LINE_BYTES; }
 
+/* The start of every traversal: state and hit cleared, the rays the units
+ * reject (NaN/Inf, zero direction, bad M) refused with -1 before any unit
+ * activity, the ray set and prepared; the memory image has node_bytes of
+ * nodes from address 0, then nids 4-byte primitive IDs, then the triangles. */
+static inline int trav_begin(trav_state *ts, cbvh_trav_hit *hit, const cbvh_ray *ray, int M, const cbvh_tri *tris,
+                             cbvh_trav_mode mode, uint64_t node_bytes, uint64_t nids) {
+    memset(ts, 0, sizeof *ts);
+    memset(hit, 0, sizeof *hit);
+    if (cbvh_rb_ray_status(ray, M)) return -1;
+    trav_set_ray(ts, ray);
+    ts->tris = tris;
+    ts->mode = mode;
+    ts->M = M;
+    ts->ids_base = trav_align(node_bytes);
+    ts->tris_base = trav_align(ts->ids_base + nids * 4u);
+    return 0;
+}
+
 static inline void trav_fetch(trav_state *ts, uint64_t addr, uint64_t size) {
     uint64_t n = cbvh_lines_touched(addr, size);
     ts->s.lines += n;

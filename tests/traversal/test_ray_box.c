@@ -123,6 +123,55 @@ static void fail(const char *what, const cbvh_ray *r, int M, const cbvh_grid_axi
     }
 }
 
+/* The plain float traversal's box test for ray against [tmin, tmax]: the
+ * variant the ray calls for, or the general one (general = 1). */
+static void ref_box(const cbvh_ray *ray, const float box[12], int general, int hit[2], double t_lo[2]) {
+    cbvh_ref_ray rr;
+    cbvh_ref_prepare(ray, &rr);
+    double cull = cbvh_float_of(ray->tmax);
+    if (general) cbvh_ref_box2_any(&rr, box, cull, hit, t_lo);
+    else cbvh_ref_box2_for(&rr, box, cull, hit, t_lo);
+}
+
+/* The exact slab test on rational planes lo[a] <= hi[a]: 1 on a hit, with
+ * tn / tf the exact near / far t (far_inf: no finite far), near_axis /
+ * far_axis the axis that set them (-1: tmin / tmax). */
+static int exact_slab(const cbvh_ray *ray, mpq_t lo[3], mpq_t hi[3], mpq_t tn, mpq_t tf, int *far_inf,
+                      int *near_axis, int *far_axis) {
+    mpq_t o, d, n, f;
+    mpq_inits(o, d, n, f, NULL);
+    int hit = 1;
+    *far_inf = ray->tmax == CBVH_F32_POS_INF;
+    *near_axis = *far_axis = -1;
+    q_f32(tn, ray->tmin);
+    if (!*far_inf) q_f32(tf, ray->tmax);
+    for (int a = 0; a < 3 && hit; a++) {
+        q_f32(o, ray->o[a]);
+        if (cbvh_f32_is_zero(ray->d[a])) {
+            if (mpq_cmp(o, lo[a]) < 0 || mpq_cmp(o, hi[a]) > 0) hit = 0;
+            continue;
+        }
+        q_f32(d, ray->d[a]);
+        int neg = mpq_sgn(d) < 0;
+        mpq_sub(n, neg ? hi[a] : lo[a], o);
+        mpq_div(n, n, d);
+        mpq_sub(f, neg ? lo[a] : hi[a], o);
+        mpq_div(f, f, d);
+        if (mpq_cmp(n, tn) > 0) {
+            mpq_set(tn, n);
+            *near_axis = a;
+        }
+        if (*far_inf || mpq_cmp(f, tf) < 0) {
+            mpq_set(tf, f);
+            *far_inf = 0;
+            *far_axis = a;
+        }
+    }
+    if (hit && !*far_inf && mpq_cmp(tn, tf) > 0) hit = 0;
+    mpq_clears(o, d, n, f, NULL);
+    return hit;
+}
+
 /* Check one input against the oracle. */
 static void check(const cbvh_ray *ray, int M, const cbvh_grid_axis g[3]) {
     cbvh_box_result res;
@@ -131,37 +180,15 @@ static void check(const cbvh_ray *ray, int M, const cbvh_grid_axis g[3]) {
         fail("unexpected reject", ray, M, g);
         return;
     }
-    mpq_t lo, hi, o, d, tn, tf, n, f, t;
-    mpq_inits(lo, hi, o, d, tn, tf, n, f, t, NULL);
-    int far_inf = ray->tmax == CBVH_F32_POS_INF, hit = 1;
-    int near_axis = -1, far_axis = -1; /* which plane set the exact extreme (-1: tmin/tmax) */
-    q_f32(tn, ray->tmin);
-    if (!far_inf) q_f32(tf, ray->tmax);
-    for (int a = 0; a < 3 && hit; a++) {
-        q_grid(lo, g[a].u, g[a].e, g[a].r);
-        q_grid(hi, g[a].u, g[a].e, g[a].s);
-        q_f32(o, ray->o[a]);
-        if (cbvh_f32_is_zero(ray->d[a])) {
-            if (mpq_cmp(o, lo) < 0 || mpq_cmp(o, hi) > 0) hit = 0;
-            continue;
-        }
-        q_f32(d, ray->d[a]);
-        int neg = mpq_sgn(d) < 0;
-        mpq_sub(n, neg ? hi : lo, o);
-        mpq_div(n, n, d);
-        mpq_sub(f, neg ? lo : hi, o);
-        mpq_div(f, f, d);
-        if (mpq_cmp(n, tn) > 0) {
-            mpq_set(tn, n);
-            near_axis = a;
-        }
-        if (far_inf || mpq_cmp(f, tf) < 0) {
-            mpq_set(tf, f);
-            far_inf = 0;
-            far_axis = a;
-        }
+    mpq_t lo[3], hi[3], tn, tf, t;
+    for (int a = 0; a < 3; a++) {
+        mpq_inits(lo[a], hi[a], NULL);
+        q_grid(lo[a], g[a].u, g[a].e, g[a].r);
+        q_grid(hi[a], g[a].u, g[a].e, g[a].s);
     }
-    if (hit && !far_inf && mpq_cmp(tn, tf) > 0) hit = 0;
+    mpq_inits(tn, tf, t, NULL);
+    int far_inf, near_axis, far_axis;
+    int hit = exact_slab(ray, lo, hi, tn, tf, &far_inf, &near_axis, &far_axis);
     n_exact_hit += hit;
     /* the plain float traversal's box test on the same planes, as both children */
     float box[12];
@@ -176,13 +203,9 @@ static void check(const cbvh_ray *ray, int M, const cbvh_grid_axis g[3]) {
         }
     }
     if (planes_ok) {
-        cbvh_ref_ray rr;
-        cbvh_ref_prepare(ray, &rr);
         int rh[2];
         double tl[2];
-        double cull = cbvh_float_of(ray->tmax);
-        if (rr.general) cbvh_ref_box2_any(&rr, box, cull, rh, tl);
-        else cbvh_ref_box2(&rr, box, cull, rh, tl);
+        ref_box(ray, box, 0, rh, tl);
         n_ref_checked++;
         n_ref_exact_hit += hit;
         n_ref_hit += rh[0];
@@ -219,7 +242,20 @@ static void check(const cbvh_ray *ray, int M, const cbvh_grid_axis g[3]) {
             if (mpq_cmp(t, tf) >= 0) fail("t_far not tight", ray, M, g);
         }
     } else if (res.t_near || res.t_far) fail("miss with non-zero t", ray, M, g);
-    mpq_clears(lo, hi, o, d, tn, tf, n, f, t, NULL);
+    for (int a = 0; a < 3; a++) mpq_clears(lo[a], hi[a], NULL);
+    mpq_clears(tn, tf, t, NULL);
+}
+
+/* The ray interval of kind tk: 0 random tmin, +Inf; 1 [0, +Inf]; 2 [0, random];
+ * 3 [0, random] ordered (a random tmax below 0 becomes tmin). */
+static void set_interval(cbvh_ray *r, int tk) {
+    r->tmin = tk == 0 ? rfloat() : 0;
+    r->tmax = tk <= 1 ? CBVH_F32_POS_INF : rfloat();
+    if (tk == 3 && cbvh_f32_key(r->tmax) < cbvh_f32_key(r->tmin)) {
+        cbvh_f32 x = r->tmin;
+        r->tmin = r->tmax;
+        r->tmax = x;
+    }
 }
 
 /* A grid axis around a random value, sometimes extreme. */
@@ -283,45 +319,22 @@ static void random_case(int M) {
     }
     if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[0] = 0x3F800000u;
     int tk = kind >= 3 && kind <= 4 ? (int)below(2) : (int)below(4);
-    r.tmin = tk == 0 ? rfloat() : 0;
-    r.tmax = tk <= 1 ? CBVH_F32_POS_INF : rfloat();
-    if (tk == 3 && cbvh_f32_key(r.tmax) < cbvh_f32_key(r.tmin)) {
-        cbvh_f32 x = r.tmin;
-        r.tmin = r.tmax;
-        r.tmax = x;
-    }
+    set_interval(&r, tk);
     check(&r, M, g);
 }
 
 /* The plain float box test on a binary32 box [lo, hi] against the exact slab
  * test: never a false miss, t_lo <= the exact near t. */
 static void check_ref_float(const cbvh_ray *ray, const cbvh_f32 lo[3], const cbvh_f32 hi[3], cbvh_f32 lo1) {
-    mpq_t ql, qh, o, d, tn, tf, n, f;
-    mpq_inits(ql, qh, o, d, tn, tf, n, f, NULL);
-    int far_inf = ray->tmax == CBVH_F32_POS_INF, hit = 1;
-    q_f32(tn, ray->tmin);
-    if (!far_inf) q_f32(tf, ray->tmax);
-    for (int a = 0; a < 3 && hit; a++) {
-        q_f32(ql, lo[a]);
-        q_f32(qh, hi[a]);
-        q_f32(o, ray->o[a]);
-        if (cbvh_f32_is_zero(ray->d[a])) {
-            if (mpq_cmp(o, ql) < 0 || mpq_cmp(o, qh) > 0) hit = 0;
-            continue;
-        }
-        q_f32(d, ray->d[a]);
-        int neg = mpq_sgn(d) < 0;
-        mpq_sub(n, neg ? qh : ql, o);
-        mpq_div(n, n, d);
-        mpq_sub(f, neg ? ql : qh, o);
-        mpq_div(f, f, d);
-        if (mpq_cmp(n, tn) > 0) mpq_set(tn, n);
-        if (far_inf || mpq_cmp(f, tf) < 0) {
-            mpq_set(tf, f);
-            far_inf = 0;
-        }
+    mpq_t ql[3], qh[3], tn, tf, n;
+    for (int a = 0; a < 3; a++) {
+        mpq_inits(ql[a], qh[a], NULL);
+        q_f32(ql[a], lo[a]);
+        q_f32(qh[a], hi[a]);
     }
-    if (hit && !far_inf && mpq_cmp(tn, tf) > 0) hit = 0;
+    mpq_inits(tn, tf, n, NULL);
+    int far_inf, near_axis, far_axis;
+    int hit = exact_slab(ray, ql, qh, tn, tf, &far_inf, &near_axis, &far_axis);
     /* child 0 is the box, child 1 the same box with lo_x = lo1 (<= lo_x: a superset) */
     float box[12];
     for (int a = 0; a < 3; a++)
@@ -329,17 +342,10 @@ static void check_ref_float(const cbvh_ray *ray, const cbvh_f32 lo[3], const cbv
             box[CBVH_REF_AT(0, a, c)] = bf(a == 0 && c == 1 ? lo1 : lo[a]);
             box[CBVH_REF_AT(1, a, c)] = bf(hi[a]);
         }
-    cbvh_ref_ray rr;
-    cbvh_ref_prepare(ray, &rr);
-    int rh[2];
-    double tl[2];
-    double cull = cbvh_float_of(ray->tmax);
-    if (rr.general) cbvh_ref_box2_any(&rr, box, cull, rh, tl);
-    else cbvh_ref_box2(&rr, box, cull, rh, tl);
-    /* the general variant is conservative for every ray */
-    int gh[2];
-    double gl[2];
-    cbvh_ref_box2_any(&rr, box, cull, gh, gl);
+    int rh[2], gh[2];
+    double tl[2], gl[2];
+    ref_box(ray, box, 0, rh, tl);
+    ref_box(ray, box, 1, gh, gl); /* the general variant is conservative for every ray */
     n_ref_checked++;
     n_ref_exact_hit += hit;
     n_ref_hit += rh[0];
@@ -351,7 +357,8 @@ static void check_ref_float(const cbvh_ray *ray, const cbvh_f32 lo[3], const cbv
         mpq_set_d(n, gl[0]);
         if (mpq_cmp(n, tn) > 0) fail("plain float box: general t_lo above exact near", ray, 24, none);
     }
-    mpq_clears(ql, qh, o, d, tn, tf, n, f, NULL);
+    for (int a = 0; a < 3; a++) mpq_clears(ql[a], qh[a], NULL);
+    mpq_clears(tn, tf, n, NULL);
 }
 
 /* A random binary32 box and a ray that often starts on its faces, inside it,
@@ -388,13 +395,7 @@ static void random_float_box(void) {
         }
     if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[0] = 0x3F800000u;
     int tk = (int)below(4);
-    r.tmin = tk == 0 ? rfloat() : 0;
-    r.tmax = tk <= 1 ? CBVH_F32_POS_INF : rfloat();
-    if (tk == 3 && cbvh_f32_key(r.tmax) < cbvh_f32_key(r.tmin)) {
-        cbvh_f32 x = r.tmin;
-        r.tmin = r.tmax;
-        r.tmax = x;
-    }
+    set_interval(&r, tk);
     cbvh_f32 lo1 = below(2) ? lo[0] : rfloat();
     if (cbvh_f32_key(lo1) > cbvh_f32_key(lo[0])) lo1 = lo[0];
     check_ref_float(&r, lo, hi, lo1);
