@@ -189,8 +189,28 @@ static void bad_rays(void) {
     cbvh_scene_free(&s);
 }
 
-/* The plain traversal's layout refuses what is not a tree, with a reason. */
-static void bad_layout(void) {
+/* The plain traversal's layout: a one-leaf BVH (no records) traces like the
+ * unit traversal; what is not a tree is refused with a reason. */
+static void layout_cases(void) {
+    {
+        cbvh_tri tri = {{{fb(0), fb(0), fb(0)}, {fb(1), fb(0), fb(0)}, {fb(0), fb(1), fb(0)}}};
+        cbvh_bvh_node leaf = {{0, 0, 0}, {1, 1, 0}, {0, 0}, 0, 1};
+        uint32_t prim = 0;
+        cbvh_bvh b1 = {&leaf, 1, 0, &prim, 1};
+        cbvh_fbvh f1;
+        char e1[256] = "";
+        cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(1)}, {0, CBVH_F32_SIGN, fb(-1)}, 0, CBVH_F32_POS_INF};
+        cbvh_trav_hit hp, hu;
+        cbvh_trav_stats sp = {0}, su = {0};
+        if (cbvh_fbvh_build(&b1, &f1, e1, sizeof e1) || f1.nnodes != 0 ||
+            cbvh_trace_bvh_float(&f1, &tri, &r, CBVH_TRAV_CLOSEST, &hp, &sp) ||
+            cbvh_trace_bvh(&b1, &tri, &r, 24, CBVH_TRAV_CLOSEST, &hu, &su) || !hp.hit || !same_hit(&hp, &hu) ||
+            hp.t != fb(1) || sp.box_tests != 1 || sp.tri_tests != 1 || sp.nodes != 0 || sp.lines != su.lines) {
+            fprintf(stderr, "FAIL one-leaf BVH: plain hit %d t %08X, unit hit %d (%s)\n", hp.hit, hp.t, hu.hit, e1);
+            failures++;
+        }
+        cbvh_fbvh_free(&f1);
+    }
     cbvh_bvh_node nodes[3] = {{{0, 0, 0}, {1, 1, 1}, {1, 2}, 0, 0},
                               {{0, 0, 0}, {1, 1, 1}, {0, 0}, 0, 1},
                               {{0, 0, 0}, {1, 1, 1}, {0, 0}, 1, 1}};
@@ -218,7 +238,7 @@ static void bad_layout(void) {
 
 int main(void) {
     bad_rays();
-    bad_layout();
+    layout_cases();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
     run_scene("proc:far:8");
     run_scene("proc:cloth:24");
