@@ -110,7 +110,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     struct {
         uint32_t entry, node;
         double t_lo; /* lower bound of its entry t */
-    } stack[CBVH_TRAV_STACK + 2];
+    } stack[CBVH_TRAV_STACK];
     int sp = 0;
     uint32_t max_stack = 0;
     uint64_t nodes = 0;
@@ -120,45 +120,50 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     double tl[2];
     ts.s.box_tests++;
     cbvh_ref_box2_for(&r, f->root_box, cull, h, tl);
-    if (h[0]) {
-        stack[0].entry = f->root;
-        stack[0].node = f->root_node;
-        stack[0].t_lo = tl[0];
-        sp = max_stack = 1;
-    }
-    while (sp > 0) {
-        sp--;
-        if (stack[sp].t_lo > cull) continue; /* culled since it was pushed */
-        uint32_t e = stack[sp].entry, ni = stack[sp].node;
+    /* the node being visited is kept out of the stack (e, ni): a node's
+     * nearer hit child is visited next without a push and a pop, the farther
+     * one pushed.  The visiting order is that of pushing both (farther
+     * first) and popping, and max_stack counts the visited entry too. */
+    uint32_t e = f->root, ni = f->root_node;
+    int have = h[0];
+    if (have) max_stack = 1;
+    while (have) {
         if (e & CBVH_FBVH_LEAF) {
             uint32_t first = e & ~CBVH_FBVH_LEAF, count = ni;
             trav_fetch(&ts, ts.ids_base + (uint64_t)first * 4u, (uint64_t)count * 4u);
             for (uint32_t i = 0; i < count && !ts.done; i++) trav_triangle(&ts, b->prims[first + i]);
             if (ts.done) break;
             cull = cbvh_float_of(trav_box_tmax(&ts));
+            h[0] = h[1] = 0;
+        } else {
+            const cbvh_fbvh_node *n = &f->nodes[e];
+            nodes++; /* the float BVH's node ni: one line at ni * 64, two box tests */
+            cbvh_ref_box2_for(&r, n->box, cull, h, tl);
+            if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
+            if (h[0] & h[1]) { /* push the farther (ties: child 1), visit the nearer */
+                int far = tl[1] < tl[0] ? 0 : 1;
+                stack[sp].entry = n->child[far];
+                stack[sp].node = n->node[far];
+                stack[sp++].t_lo = tl[far];
+                e = n->child[far ^ 1];
+                ni = n->node[far ^ 1];
+            } else if (h[0] | h[1]) {
+                e = n->child[h[1]];
+                ni = n->node[h[1]];
+            }
+            /* its hit test used cull, so t_lo <= cull: the pop check would pass */
+        }
+        if (h[0] | h[1]) {
+            if ((uint32_t)sp + 1u > max_stack) max_stack = (uint32_t)sp + 1u;
             continue;
         }
-        const cbvh_fbvh_node *n = &f->nodes[e];
-        nodes++; /* the float BVH's node ni: one line at ni * 64, two box tests */
-        cbvh_ref_box2_for(&r, n->box, cull, h, tl);
-        if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
-        /* push the farther child first so the nearer one is visited next;
-         * both slots are written, sp advances only past the hit ones (no
-         * unpredictable branches) */
-        int far = tl[1] < tl[0] ? 0 : 1;
-        for (int k = 0; k < 2; k++) {
-            int c = far ^ k;
-            stack[sp].entry = n->child[c];
-            stack[sp].node = n->node[c];
-            stack[sp].t_lo = tl[c];
-            sp += h[c];
-        }
-        if ((uint32_t)sp > max_stack) max_stack = (uint32_t)sp;
-        /* the next node's record, or the next leaf's primitive IDs */
-        if (sp > 0) {
-            uint32_t top = stack[sp - 1].entry;
-            if (top & CBVH_FBVH_LEAF) __builtin_prefetch(&b->prims[top & ~CBVH_FBVH_LEAF]);
-            else __builtin_prefetch(&f->nodes[top]);
+        /* pop the next entry not culled since it was pushed */
+        have = 0;
+        while (sp > 0 && !have) {
+            sp--;
+            have = !(stack[sp].t_lo > cull);
+            e = stack[sp].entry;
+            ni = stack[sp].node;
         }
     }
     ts.s.nodes += nodes;
