@@ -765,7 +765,8 @@ static int case_grazing_face(void) {
     return failures != 0;
 }
 
-/* >= 1 M rays from inside closed meshes, through the CBVH (N = 6): no leaks. */
+/* >= 1 M rays from inside closed meshes, through the CBVH (N = 6) and the plain
+ * floating-point traversal of its float BVH: no leaks. */
 static long leak_rays(world *w, const mesh *m, long n, double inner_r, int cube) {
     const cbvh_tree *t = &w->tr[0].t;
     double off[3] = {0, 0, 0};
@@ -820,6 +821,16 @@ static long leak_rays(world *w, const mesh *m, long n, double inner_r, int cube)
             FAIL("closed_mesh_no_leaks: %s ray %ld leaked (target kind %d)", cube ? "cube" : "sphere", i, kind);
             print_ray("", &r);
         }
+        /* the plain floating-point traversal has its own box test: no leak either */
+        cbvh_trav_hit hp;
+        cbvh_trav_stats sp = {0};
+        if (cbvh_trace_bvh_float(&w->fb[0], w->s.tris, &r, (i & 3) ? CBVH_TRAV_ANY : CBVH_TRAV_CLOSEST, &hp, &sp) ||
+            !hp.hit) {
+            leaks++;
+            FAIL("closed_mesh_no_leaks: %s ray %ld leaked through the plain float traversal", cube ? "cube" : "sphere",
+                 i);
+            print_ray("", &r);
+        }
         if (i % 997 == 0) check_ray(w, &r, i % (997 * 8) == 0); /* all structures; brute force on a subset */
     }
     return leaks;
@@ -847,7 +858,8 @@ static int case_closed_mesh_no_leaks(void) {
         world_free(&w);
     }
     printf("closed_mesh_no_leaks: %ld rays from inside (25%% at vertices, 50%% at edge midpoints, 10%% axis-parallel) "
-           "through the CBVH N=6, %ld leaks, %ld cross-checks against the float BVHs/brute force, %ld failures\n",
+           "through the CBVH N=6 and the plain float traversal, %ld leaks, %ld cross-checks against the float "
+           "BVHs/brute force, %ld failures\n",
            rays, leaks, checks, failures);
     if (rays < total) FAIL("closed_mesh_no_leaks: only %ld rays traced", rays);
     (void)hits;
