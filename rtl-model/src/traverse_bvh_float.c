@@ -122,8 +122,8 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     cbvh_ref_box2_for(&r, f->root_box, cull, h, tl);
     /* the node being visited is kept out of the stack (e, ni): a node's
      * nearer hit child is visited next without a push and a pop, the farther
-     * one pushed.  The visiting order is that of pushing both (farther
-     * first) and popping, and max_stack counts the visited entry too. */
+     * one pushed.  Visiting order, culling and max_stack are those of pushing
+     * both (farther first) and popping: max_stack counts the visited entry. */
     uint32_t e = f->root, ni = f->root_node;
     int have = h[0];
     if (have) max_stack = 1;
@@ -134,28 +134,30 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
             for (uint32_t i = 0; i < count && !ts.done; i++) trav_triangle(&ts, b->prims[first + i]);
             if (ts.done) break;
             cull = cbvh_float_of(trav_box_tmax(&ts));
-            h[0] = h[1] = 0;
         } else {
             const cbvh_fbvh_node *n = &f->nodes[e];
             nodes++; /* the float BVH's node ni: one line at ni * 64, two box tests */
             cbvh_ref_box2_for(&r, n->box, cull, h, tl);
             if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
+            int next = -1; /* the child visited next, if any */
             if (h[0] & h[1]) { /* push the farther (ties: child 1), visit the nearer */
                 int far = tl[1] < tl[0] ? 0 : 1;
                 stack[sp].entry = n->child[far];
                 stack[sp].node = n->node[far];
                 stack[sp++].t_lo = tl[far];
-                e = n->child[far ^ 1];
-                ni = n->node[far ^ 1];
+                next = far ^ 1;
             } else if (h[0] | h[1]) {
-                e = n->child[h[1]];
-                ni = n->node[h[1]];
+                next = h[1];
             }
-            /* its hit test used cull, so t_lo <= cull: the pop check would pass */
-        }
-        if (h[0] | h[1]) {
-            if ((uint32_t)sp + 1u > max_stack) max_stack = (uint32_t)sp + 1u;
-            continue;
+            if (next >= 0) {
+                if ((uint32_t)sp + 1u > max_stack) max_stack = (uint32_t)sp + 1u;
+                /* the pop's cull check (rounding can leave t_lo just above cull) */
+                if (!(tl[next] > cull)) {
+                    e = n->child[next];
+                    ni = n->node[next];
+                    continue;
+                }
+            }
         }
         /* pop the next entry not culled since it was pushed */
         have = 0;
