@@ -143,15 +143,15 @@ static inline int cbvh_rbf_box(const cbvh_rbf_ray *p, double tmax, const double 
  * decided; hit[c] and t_near[c] as for cbvh_rbf_box.  The same binary64
  * operations lane by lane, written as plain C over two-element arrays (no
  * compiler vector extensions; -O3 may pair the lanes itself). */
-static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double lo[3][2], const double hi[3][2],
-                                int hit[2], double t_near[2]) {
+static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const double lo[3][2],
+                                     const double hi[3][2], int check_planes, int hit[2], double t_near[2]) {
     double nh[2] = {-HUGE_VAL, -HUGE_VAL}, fh[2] = {HUGE_VAL, HUGE_VAL};
     int okv[2] = {1, 1};
     for (int a = 0; a < 3; a++) {
         const double *pn = p->near_hi[a] ? hi[a] : lo[a], *pf = p->near_hi[a] ? lo[a] : hi[a];
         for (int c = 0; c < 2; c++) {
             double w = hi[a][c] - lo[a][c];
-            okv[c] &= (w >= 0) & (w <= DBL_MAX);
+            if (check_planes) okv[c] &= (w >= 0) & (w <= DBL_MAX);
             double n = (pn[c] - p->o[a]) * p->inv[a], f = (pf[c] - p->o[a]) * p->inv[a];
             nh[c] = n > nh[c] ? n : nh[c];
             fh[c] = f < fh[c] ? f : fh[c];
@@ -169,6 +169,19 @@ static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double
         res |= ok << c;
     }
     return res;
+}
+
+static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double lo[3][2], const double hi[3][2],
+                                int hit[2], double t_near[2]) {
+    return cbvh_rbf_box2_core(p, tmax, lo, hi, 1, hit, t_near);
+}
+
+/* The same for planes known to satisfy lo < hi, both finite (the CBVH's
+ * decoded grid planes u + r 2^e < u + s 2^e, exact in binary64): the
+ * validity tests are skipped. */
+static inline int cbvh_rbf_box2_valid(const cbvh_rbf_ray *p, double tmax, const double lo[3][2],
+                                      const double hi[3][2], int hit[2], double t_near[2]) {
+    return cbvh_rbf_box2_core(p, tmax, lo, hi, 0, hit, t_near);
 }
 
 /* An axis of a node's context (u = clb, e = scale in [-126, 126]) in

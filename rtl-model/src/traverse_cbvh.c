@@ -109,7 +109,8 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                     lo[a][c] = ax[a].u + (double)(fc[c].empty ? 0 : fc[c].r[a]) * ax[a].step;
                     hi[a][c] = ax[a].u + (double)(fc[c].empty ? 1 : fc[c].s[a]) * ax[a].step;
                 }
-            int dec = exact ? cbvh_rbf_box2(&fp, cull_d, lo, hi, hf, tf) : 0;
+            /* r < s (the decode's check) and exact finite planes: valid boxes */
+            int dec = exact ? cbvh_rbf_box2_valid(&fp, cull_d, lo, hi, hf, tf) : 0;
             for (int c = 0; c < 2; c++) {
                 if (fc[c].empty) continue;
                 ts.s.box_tests++;
