@@ -75,6 +75,7 @@ static cbvh_f32 plane_on_grid(cbvh_f32 o, cbvh_f32 d, int M, int nudge) {
 
 /* cbvh_rbf_box2 on (box, other box) equals cbvh_rbf_box on each lane. */
 static double prev_lo[3], prev_hi[3];
+static long n_valid_pairs;
 static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], const double hi[3], int dec, int hit,
                        double tn, long i) {
     double l2[3][2], h2[3][2], t2[2], tb = 0;
@@ -90,6 +91,20 @@ static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], c
     if (d2 != (dec | decb << 1) || (dec && (hit2[0] != hit || t2[0] != tn)) ||
         (decb && (hit2[1] != hb || t2[1] != tb))) {
         if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2 differs from cbvh_rbf_box\n", i);
+    }
+    /* the variant without validity tests, on pairs of valid boxes (lo < hi, finite) */
+    int valid = 1;
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 2; c++) valid &= l2[a][c] < h2[a][c] && isfinite(l2[a][c]) && isfinite(h2[a][c]);
+    if (valid) {
+        int hv[2];
+        double tv[2];
+        int dv = cbvh_rbf_box2_valid(p, tmax, (const double(*)[2])l2, (const double(*)[2])h2, hv, tv);
+        n_valid_pairs++;
+        if (dv != d2 || ((dv & 1) && (hv[0] != hit2[0] || tv[0] != t2[0])) ||
+            ((dv & 2) && (hv[1] != hit2[1] || tv[1] != t2[1]))) {
+            if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2_valid differs from cbvh_rbf_box2\n", i);
+        }
     }
     memcpy(prev_lo, lo, sizeof prev_lo);
     memcpy(prev_hi, hi, sizeof prev_hi);
@@ -399,6 +414,11 @@ int main(void) {
     test_float_boxes();
     test_grid_boxes();
     test_pair_decode();
+    printf("box pairs with valid planes (cbvh_rbf_box2_valid checked): %ld\n", n_valid_pairs);
+    if (n_valid_pairs < 100000) {
+        printf("FAIL: too few valid box pairs\n");
+        failures++;
+    }
     if (failures) {
         printf("test_box_f64: %ld failures\n", failures);
         return 1;
