@@ -1,6 +1,6 @@
 /* The plain floating-point traversal's box test (docs/traversal.md §11): a
  * conservative binary64 slab test of two boxes at once, not the M-bit unit.
- * Internal to rtl-model; tests/traversal/test_box_ref.c checks it against an
+ * Internal to rtl-model; tests/traversal/test_ray_box.c checks it against an
  * exact rational slab test.
  *
  * Error bound: for binary32 planes p, origin o and direction d != 0, the
@@ -30,23 +30,22 @@ typedef struct {
     double o[3], inv[3]; /* inv = 1 / d, 0 where d = +-0 */
     double tmin;
     int pn[3], pf[3]; /* CBVH_REF_AT(near / far plane, a, 0): the near plane is hi where d_a < 0 */
-    int axis_par;     /* some d_a = +-0 */
-    int general;      /* axis_par or tmin < 0: cbvh_ref_box2_any, not cbvh_ref_box2 */
+    int general;      /* some d_a = +-0, or tmin < 0: cbvh_ref_box2_any, not cbvh_ref_box2 */
 } cbvh_ref_ray;
 
 /* For a ray the units accept (finite, d != 0). */
 static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
-    r->axis_par = 0;
+    int axis_par = 0;
     for (int a = 0; a < 3; a++) {
         double d = cbvh_float_of(ray->d[a]);
         r->o[a] = cbvh_float_of(ray->o[a]);
         r->inv[a] = d != 0 ? 1.0 / d : 0;
         r->pn[a] = CBVH_REF_AT(d < 0, a, 0);
         r->pf[a] = CBVH_REF_AT(!(d < 0), a, 0);
-        if (d == 0) r->axis_par = 1;
+        axis_par |= d == 0;
     }
     r->tmin = cbvh_float_of(ray->tmin);
-    r->general = r->axis_par || r->tmin < 0;
+    r->general = axis_par || r->tmin < 0;
 }
 
 /* Two boxes (lo <= hi, finite) against [tmin, cull] for a ray without zero

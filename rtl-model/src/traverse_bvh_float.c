@@ -18,12 +18,12 @@ static void set_box(float box[12], int c, const cbvh_bvh_node *n) {
     }
 }
 
-/* A child's entry: its record, or for a leaf CBVH_FBVH_LEAF | first with the
- * leaf's count in the node word. */
+/* A child's entry: its record, or for a leaf CBVH_FBVH_LEAF | first and its
+ * count. */
 static void set_child(cbvh_fbvh_node *r, int c, const cbvh_bvh *b, uint32_t node, const uint32_t *rec) {
     const cbvh_bvh_node *n = &b->nodes[node];
     r->child[c] = cbvh_bvh_is_leaf(n) ? CBVH_FBVH_LEAF | n->first : rec[node];
-    r->node[c] = cbvh_bvh_is_leaf(n) ? n->count : node;
+    r->count[c] = n->count; /* 0 for an inner node */
 }
 
 int cbvh_fbvh_build(const cbvh_bvh *b, cbvh_fbvh *out, char *err, size_t errlen) {
@@ -82,7 +82,7 @@ int cbvh_fbvh_build(const cbvh_bvh *b, cbvh_fbvh *out, char *err, size_t errlen)
     cbvh_fbvh_node root;
     set_child(&root, 0, b, b->root, rec);
     out->root = root.child[0];
-    out->root_node = root.node[0];
+    out->root_count = root.count[0];
     set_box(out->root_box, 0, &b->nodes[b->root]);
     set_box(out->root_box, 1, &b->nodes[b->root]);
 
@@ -105,10 +105,10 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     cbvh_ref_ray r;
     cbvh_ref_prepare(ray, &r);
 
-    /* the stack holds child entries as in the records: a record index and its
-     * node index, or CBVH_FBVH_LEAF | first and the count */
+    /* the stack holds child entries as in the records: a record index, or
+     * CBVH_FBVH_LEAF | first and the count */
     struct {
-        uint32_t entry, node;
+        uint32_t entry, count;
         double t_lo; /* lower bound of its entry t */
     } stack[CBVH_TRAV_STACK];
     int sp = 0;
@@ -120,30 +120,30 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     double tl[2];
     ts.s.box_tests++;
     cbvh_ref_box2_for(&r, f->root_box, cull, h, tl);
-    /* the node being visited is kept out of the stack (e, ni): a node's
+    /* the node being visited is kept out of the stack (e, cnt): a node's
      * nearer hit child is visited next without a push and a pop, the farther
      * one pushed.  Visiting order, culling and max_stack are those of pushing
      * both (farther first) and popping: max_stack counts the visited entry. */
-    uint32_t e = f->root, ni = f->root_node;
+    uint32_t e = f->root, cnt = f->root_count;
     int have = h[0];
     if (have) max_stack = 1;
     while (have) {
         if (e & CBVH_FBVH_LEAF) {
-            uint32_t first = e & ~CBVH_FBVH_LEAF, count = ni;
-            trav_fetch(&ts, ts.ids_base + (uint64_t)first * 4u, (uint64_t)count * 4u);
-            for (uint32_t i = 0; i < count && !ts.done; i++) trav_triangle(&ts, b->prims[first + i]);
+            uint32_t first = e & ~CBVH_FBVH_LEAF;
+            trav_fetch(&ts, ts.ids_base + (uint64_t)first * 4u, (uint64_t)cnt * 4u);
+            for (uint32_t i = 0; i < cnt && !ts.done; i++) trav_triangle(&ts, b->prims[first + i]);
             if (ts.done) break;
             cull = cbvh_float_of(trav_box_tmax(&ts));
         } else {
             const cbvh_fbvh_node *n = &f->nodes[e];
-            nodes++; /* the float BVH's node ni: one line at ni * 64, two box tests */
+            nodes++; /* in the float BVH's image one 64-byte line, and two box tests */
             cbvh_ref_box2_for(&r, n->box, cull, h, tl);
             if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
             int next = -1; /* the child visited next, if any */
             if (h[0] & h[1]) { /* push the farther (ties: child 1), visit the nearer */
                 int far = tl[1] < tl[0] ? 0 : 1;
                 stack[sp].entry = n->child[far];
-                stack[sp].node = n->node[far];
+                stack[sp].count = n->count[far];
                 stack[sp++].t_lo = tl[far];
                 next = far ^ 1;
             } else if (h[0] | h[1]) {
@@ -154,7 +154,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
                 /* the pop's cull check (rounding can leave t_lo just above cull) */
                 if (!(tl[next] > cull)) {
                     e = n->child[next];
-                    ni = n->node[next];
+                    cnt = n->count[next];
                     continue;
                 }
             }
@@ -165,7 +165,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
             sp--;
             have = !(stack[sp].t_lo > cull);
             e = stack[sp].entry;
-            ni = stack[sp].node;
+            cnt = stack[sp].count;
         }
     }
     ts.s.nodes += nodes;

@@ -219,7 +219,7 @@ static void layout_cases(void) {
     cbvh_fbvh f;
     char err[256] = "";
     if (cbvh_fbvh_build(&b, &f, err, sizeof err) || f.nnodes != 1 || f.root != 0 ||
-        f.nodes[0].child[1] != (CBVH_FBVH_LEAF | 1u) || f.nodes[0].node[1] != 1) {
+        f.nodes[0].child[1] != (CBVH_FBVH_LEAF | 1u) || f.nodes[0].count[1] != 1) {
         fprintf(stderr, "FAIL layout of a 3-node tree: %s\n", err);
         failures++;
     }

@@ -65,15 +65,14 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
 typedef struct {
     float box[12];       /* ((plane * 3) + axis) * 2 + child, plane 0 = lo, 1 = hi */
     uint32_t child[2];   /* inner child: record index; leaf: CBVH_FBVH_LEAF | its first primitive */
-    uint32_t node[2];    /* inner child: its node index in the float BVH (the counters' address);
-                          * leaf: its primitive count */
+    uint32_t count[2];   /* leaf child: its primitive count; inner: 0 */
 } cbvh_fbvh_node;
 
 typedef struct {
     const cbvh_bvh *bvh; /* not owned: leaves, primitive IDs and the counters' addresses */
     cbvh_fbvh_node *nodes; /* 64-byte aligned */
     uint32_t nnodes;
-    uint32_t root, root_node; /* the root as a child entry (child[], node[]) */
+    uint32_t root, root_count; /* the root as a child entry (child[], count[]) */
     float root_box[12];  /* the root's box as child 0 (child 1 a copy) */
 } cbvh_fbvh;
 
