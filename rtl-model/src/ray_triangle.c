@@ -131,12 +131,7 @@ uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3],
  * bounds' own rounding, so the bounds also hold if the compiler contracts
  * (the file is compiled with -ffp-contract=off anyway, so the filter's
  * decisions are reproducible). */
-static double dabs(double x) { return fabs(x); } /* one AND of the sign bit */
-static double f32d(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return (double)f;
-}
+static double f32d(cbvh_f32 b) { return (double)cbvh_float_of(b); }
 
 /* Truncation of a positive binary64 to binary32 (round toward zero = the
  * exact path's CBVH_RND_DOWN for a positive quotient), integer-only; 0 when
@@ -195,7 +190,7 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     const double u = 0x1p-53;
     int kx = p->kx, ky = p->ky, kz = p->kz;
     double dx = p->dx, dy = p->dy, dz = p->dz;
-    double adx = dabs(dx), ady = dabs(dy), adz = dabs(dz);
+    double adx = fabs(dx), ady = fabs(dy), adz = fabs(dz);
     double ox = p->ox, oy = p->oy, oz = p->oz;
     const cbvh_f32 *v[3] = {v0, v1, v2};
     /* X, Y, Z and bounds eX, eY, eZ on their errors (see the top of the
@@ -204,12 +199,12 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     for (int i = 0; i < 3; i++) {
         double vx = f32d(v[i][kx]), vy = f32d(v[i][ky]), vz = f32d(v[i][kz]);
         double px = vx - ox, py = vy - oy, pz = vz - oz;
-        double apz = dabs(pz);
+        double apz = fabs(pz);
         X[i] = px * dz - pz * dx;
         Y[i] = py * dz - pz * dy;
         Z[i] = pz;
-        eX[i] = 4.0 * u * (dabs(px) * adz + apz * adx);
-        eY[i] = 4.0 * u * (dabs(py) * adz + apz * ady);
+        eX[i] = 4.0 * u * (fabs(px) * adz + apz * adx);
+        eY[i] = 4.0 * u * (fabs(py) * adz + apz * ady);
         eZ[i] = 1.0001 * u * apz;
     }
     /* E_i = X_k Y_j - Y_k X_j: propagated error of the inputs plus the three
@@ -221,8 +216,8 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
         int j = (i + 1) % 3, k = (i + 2) % 3;
         double a = X[k] * Y[j], c = Y[k] * X[j];
         E[i] = a - c;
-        eE[i] = 1.001 * (dabs(X[k]) * eY[j] + dabs(Y[j]) * eX[k] + eX[k] * eY[j] + dabs(Y[k]) * eX[j] +
-                         dabs(X[j]) * eY[k] + eX[j] * eY[k] + 2.0001 * u * (dabs(a) + dabs(c)));
+        eE[i] = 1.001 * (fabs(X[k]) * eY[j] + fabs(Y[j]) * eX[k] + eX[k] * eY[j] + fabs(Y[k]) * eX[j] +
+                         fabs(X[j]) * eY[k] + eX[j] * eY[k] + 2.0001 * u * (fabs(a) + fabs(c)));
         sg[i] = E[i] > eE[i] ? 1 : E[i] < -eE[i] ? -1 : 0; /* 0: sign unknown */
     }
     if ((sg[0] < 0 || sg[1] < 0 || sg[2] < 0) && (sg[0] > 0 || sg[1] > 0 || sg[2] > 0)) return 1;
@@ -232,8 +227,8 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     double P0 = E[0] * Z[0], P1 = E[1] * Z[1], P2 = E[2] * Z[2];
     double T = P0 + P1 + P2;
     double eT = 0;
-    for (int i = 0; i < 3; i++) eT += dabs(E[i]) * eZ[i] + dabs(Z[i]) * eE[i] + eE[i] * eZ[i];
-    eT = 1.001 * (eT + 3.001 * u * (dabs(P0) + dabs(P1) + dabs(P2)));
+    for (int i = 0; i < 3; i++) eT += fabs(E[i]) * eZ[i] + fabs(Z[i]) * eE[i] + eE[i] * eZ[i];
+    eT = 1.001 * (eT + 3.001 * u * (fabs(P0) + fabs(P1) + fabs(P2)));
     int sT = T > eT ? 1 : T < -eT ? -1 : 0;
     int sden = sg[0] * (dz > 0 ? 1 : -1); /* d_z != 0: the largest |d| of a nonzero d */
     if (sT == 0) return 0;
@@ -242,13 +237,13 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     /* A certain hit: t = T / (det d_z), b1 = V / det, b2 = W / det, each the
      * truncation of a positive quotient.  det = U + V + W adds two roundings
      * (its terms share a sign: <= 2.0001u sum |E|); det d_z one more. */
-    double det = E[0] + E[1] + E[2], adet = dabs(det);
+    double det = E[0] + E[1] + E[2], adet = fabs(det);
     double e_det = 1.001 * (eE[0] + eE[1] + eE[2] + 2.0001 * u * adet);
     double den = det * dz, r_det = e_det / adet;
-    double r_den = (adz * e_det + 1.0001 * u * dabs(den)) / dabs(den);
-    cbvh_f32 t = quot_trunc(T, den, eT / dabs(T), r_den);
-    cbvh_f32 b1 = quot_trunc(E[1], det, eE[1] / dabs(E[1]), r_det);
-    cbvh_f32 b2 = quot_trunc(E[2], det, eE[2] / dabs(E[2]), r_det);
+    double r_den = (adz * e_det + 1.0001 * u * fabs(den)) / fabs(den);
+    cbvh_f32 t = quot_trunc(T, den, eT / fabs(T), r_den);
+    cbvh_f32 b1 = quot_trunc(E[1], det, eE[1] / fabs(E[1]), r_det);
+    cbvh_f32 b2 = quot_trunc(E[2], det, eE[2] / fabs(E[2]), r_det);
     if (!t || !b1 || !b2) return 0;
     memset(out, 0, sizeof *out);
     out->hit = 1;
