@@ -45,6 +45,13 @@ static inline void cbvh_lbvh_merge_box(cbvh_bvh_node *p, const cbvh_bvh_node *a,
     }
 }
 
+/* Whether the subtree over leaves [lo, hi] (not the whole range) is its
+ * parent's left child: its parent splits after hi when the code difference
+ * there is the smaller one (Apetrei 2014). */
+static inline int cbvh_lbvh_is_left(const uint32_t *codes, uint32_t m, uint32_t lo, uint32_t hi) {
+    return lo == 0 || (hi != m - 1 && (codes[hi] ^ codes[hi + 1]) < (codes[lo - 1] ^ codes[lo]));
+}
+
 /* Phase 2.  inner(ctx, node) is called for each inner node once its
  * children and box are set (post-order), unless NULL.  Inline so that a
  * constant hook is inlined too. */
@@ -60,7 +67,7 @@ static inline void cbvh_lbvh_hierarchy(cbvh_lbvh_work *w, void (*inner)(void *, 
         uint32_t lo = i, hi = i, x = L + i;
         for (;;) {
             if (lo == 0 && hi == m - 1) break; /* the root (node 0) is done */
-            int left = lo == 0 || (hi != m - 1 && (codes[hi] ^ codes[hi + 1]) < (codes[lo - 1] ^ codes[lo]));
+            int left = cbvh_lbvh_is_left(codes, m, lo, hi);
             uint32_t g = left ? hi : lo - 1;
             if (split[2 * g] == UINT32_MAX) { /* the sibling is not done yet */
                 split[2 * g] = left ? lo : hi;
@@ -75,13 +82,7 @@ static inline void cbvh_lbvh_hierarchy(cbvh_lbvh_work *w, void (*inner)(void *, 
                 lo = split[2 * g];
             /* The parent's number: 0 for the root, else its end touching its
              * own parent's split. */
-            uint32_t p;
-            if (lo == 0 && hi == m - 1)
-                p = 0;
-            else if (lo == 0 || (hi != m - 1 && (codes[hi] ^ codes[hi + 1]) < (codes[lo - 1] ^ codes[lo])))
-                p = hi;
-            else
-                p = lo;
+            uint32_t p = lo == 0 && hi == m - 1 ? 0 : cbvh_lbvh_is_left(codes, m, lo, hi) ? hi : lo;
             cbvh_bvh_node *pn = &nodes[p];
             pn->child[0] = lc;
             pn->child[1] = rc;
