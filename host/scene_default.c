@@ -14,7 +14,8 @@ static int has_suffix(const char *s, const char *suf) {
     return n >= m && strcmp(s + n - m, suf) == 0;
 }
 
-int cbvh_scene_arg_is_mesh(const char *arg) {
+/* 1 unless arg ends in .scene or .json. */
+static int arg_is_mesh(const char *arg) {
     return !(has_suffix(arg, ".scene") || has_suffix(arg, ".json"));
 }
 
@@ -96,6 +97,6 @@ int cbvh_scene_file_default(const char *mesh, cbvh_scene_desc *d, char *err, siz
 }
 
 int cbvh_scene_file_open(const char *arg, cbvh_scene_desc *d, char *err, size_t errlen) {
-    return cbvh_scene_arg_is_mesh(arg) ? cbvh_scene_file_default(arg, d, err, errlen)
+    return arg_is_mesh(arg) ? cbvh_scene_file_default(arg, d, err, errlen)
                                        : cbvh_scene_file_load(arg, d, err, errlen);
 }

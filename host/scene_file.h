@@ -108,8 +108,6 @@ int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *o
  * floor 3x the mesh; primary, hard shadows, ambient occlusion (2 samples, distance
  * 0.2 E); seed 1. */
 int cbvh_scene_file_default(const char *mesh, cbvh_scene_desc *out, char *err, size_t errlen);
-/* 1 unless arg ends in .scene or .json. */
-int cbvh_scene_arg_is_mesh(const char *arg);
 /* A scene file, or the default scene of a mesh file / proc:NAME. */
 int cbvh_scene_file_open(const char *arg, cbvh_scene_desc *out, char *err, size_t errlen);
 
