@@ -29,7 +29,7 @@ static void usage_gen(FILE *f) {
             "adds/updates their SHA-256 lines in DIR/MANIFEST. Without --unit/--bits/--min-scale it\n"
             "writes the default set: every datapath unit x N=3..10 x both encodings (where the unit\n"
             "has one), min_scale -30, plus N=6 with min_scale -126 and -10 for the axis units; the\n"
-            "units that do not depend on N (ray_box, ray_triangle, qbvh_stack) get one file each (N=6).\n\n"
+            "units that do not depend on N (ray_box, ray_triangle, qbvh_stack, ray_sphere) get one file each (N=6).\n\n"
             "  -u, --unit U           one unit (");
     for (int i = 0; i < cbvh_unit_count; i++) fprintf(f, "%s%s", i ? ", " : "", cbvh_units[i]->name);
     fprintf(f, ")\n"
@@ -49,7 +49,8 @@ static void usage_check(FILE *f) {
                "For a directory, verifies DIR/MANIFEST first (every listed file present with a matching\n"
                "SHA-256, no unlisted .vec file), then runs every vector on the backend in batches of %d\n"
                "and prints 'N passed, M failed' per file, a total with the rate, and the first mismatches.\n\n"
-               "  -b, --backend B        auto (default: board if found, else the model), model, usb, hid\n"
+               "  -b, --backend B        auto (default: board if found, else the model), model, usb, hid,\n"
+               "                         or sim:ADDR (the virtual board: sim:unix:PATH, sim:tcp:HOST:PORT)\n"
                "  -M, --max-errors K     mismatches shown in full (default 20)\n"
                "  -j, --json             one JSON object instead of text\n"
                "  -q, --quiet            no per-file lines for files that pass\n"

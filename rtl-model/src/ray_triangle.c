@@ -8,7 +8,9 @@
  * evaluates every quantity exactly (scaled by powers of d_z so no division is
  * needed), which is what the fallback approximates: the edge functions' signs
  * are exact, so a ray through a shared edge or vertex of a closed mesh always
- * hits at least one of the adjacent triangles.  Integer-only. */
+ * hits at least one of the adjacent triangles.  Integer-defined: a binary64
+ * filter runs first and returns only results it proves equal to the integer
+ * path's (docs/traversal.md §9); everything else takes the integer path. */
 #include <math.h>
 #include <string.h>
 
