@@ -1,12 +1,34 @@
 #include "backend.h"
+#include "protocol.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-void cbvh_usb_identity(uint16_t *vid, uint16_t *pid) {
-    const char *v = getenv("CBVH_USB_VID"), *p = getenv("CBVH_USB_PID");
-    *vid = v ? (uint16_t)strtoul(v, NULL, 16) : CBVH_USB_VID_DEFAULT;
-    *pid = p ? (uint16_t)strtoul(p, NULL, 16) : CBVH_USB_PID_DEFAULT;
+/* One 16-bit USB ID from the environment: 1 to 4 hex digits, optional 0x.
+ * strtoul took "zzzz" as 0, "123456" as 0x3456 (cast) and "-1" as ffff. */
+static int env_usb_id(const char *name, uint16_t def, uint16_t *id, char *err, size_t errlen) {
+    const char *s = getenv(name);
+    *id = def;
+    if (!s || !*s) return 0;
+    const char *h = s[0] == '0' && (s[1] == 'x' || s[1] == 'X') ? s + 2 : s;
+    size_t n = strspn(h, "0123456789abcdefABCDEF");
+    if (n < 1 || n > 4 || h[n]) {
+        snprintf(err, errlen, "%s='%.40s' is not a USB ID (expected 1 to 4 hex digits, optional 0x, e.g. %04x)", name,
+                 s, def);
+        return -1;
+    }
+    *id = (uint16_t)strtoul(h, NULL, 16);
+    return 0;
+}
+
+int cbvh_usb_identity(uint16_t *vid, uint16_t *pid, char *err, size_t errlen) {
+    if (env_usb_id("CBVH_USB_VID", CBVH_USB_VID_DEFAULT, vid, err, errlen) ||
+        env_usb_id("CBVH_USB_PID", CBVH_USB_PID_DEFAULT, pid, err, errlen)) {
+        *vid = CBVH_USB_VID_DEFAULT;
+        *pid = CBVH_USB_PID_DEFAULT;
+        return -1;
+    }
+    return 0;
 }
 
 static const cbvh_backend_ops *const probe_order[] = {&cbvh_backend_usb, &cbvh_backend_hid};
@@ -22,6 +44,9 @@ static int open_one(const cbvh_backend_ops *ops, const char *arg, cbvh_backend *
 
 int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen) {
     if (strcmp(spec, "auto") == 0) {
+        /* Bad settings are an error, not a reason to fall back to the model. */
+        uint16_t vid, pid;
+        if (cbvh_usb_identity(&vid, &pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen)) return -1;
         char why[2][200] = {"", ""};
         for (size_t i = 0; i < sizeof probe_order / sizeof probe_order[0]; i++) {
             int rc = open_one(probe_order[i], NULL, b, why[i], sizeof why[i]);

@@ -3,7 +3,8 @@
  *   backend_model.c   in-process bit-exact model
  *   transport_usb.c   libusb bulk (board)
  *   transport_hid.c   hidapi HID (board)
- * `auto` probes usb, then hid, then falls back to the model with one line. */
+ * `auto` probes usb, then hid, then falls back to the model with one line
+ * (but not over bad CBVH_USB_* / CBVH_LINK_* settings: those are an error). */
 #ifndef CBVH_HOST_BACKEND_H
 #define CBVH_HOST_BACKEND_H
 
@@ -47,9 +48,11 @@ int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, s
 void cbvh_backend_close(cbvh_backend *b);
 
 /* USB identity of the board (pid.codes test VID), overridable with the
- * environment variables CBVH_USB_VID / CBVH_USB_PID (hex). */
+ * environment variables CBVH_USB_VID / CBVH_USB_PID (1 to 4 hex digits,
+ * optional 0x; unset or empty: the default).  0, or -1 with err naming the
+ * variable and the accepted form (*vid, *pid then hold the defaults). */
 #define CBVH_USB_VID_DEFAULT 0x1209
 #define CBVH_USB_PID_DEFAULT 0xC0B1
-void cbvh_usb_identity(uint16_t *vid, uint16_t *pid);
+int cbvh_usb_identity(uint16_t *vid, uint16_t *pid, char *err, size_t errlen);
 
 #endif

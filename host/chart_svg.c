@@ -100,6 +100,7 @@ int cbvh_svg_chart(const char *path, const char *title, const char *xlabel, cons
         free(tmp);
         return -1;
     }
+    errno = 0; /* so a failed write below can be named (e.g. no space left) */
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     fprintf(f,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
@@ -146,8 +147,8 @@ int cbvh_svg_chart(const char *path, const char *title, const char *xlabel, cons
 #undef PY
     int werr = ferror(f);
     if (fclose(f) != 0) werr = 1;
-    if (werr) {
-        snprintf(err, errlen, "svg: writing %s failed: I/O error", path);
+    if (werr) { /* errno from the failed write or flush, e.g. no space left */
+        snprintf(err, errlen, "svg: writing %s failed: %s", path, errno ? strerror(errno) : "I/O error");
         unlink(tmp);
         free(tmp);
         return -1;

@@ -1,4 +1,5 @@
 /* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,12 +15,27 @@ static void on_signal(int sig) {
     stop_flag = 1;
 }
 
+#define RX_IDLE_MS_MAX 60000
+
+/* Strict decimal integer in lo..hi: atoi took "5x" as 5 and wrapped huge
+ * values; strtol alone would skip leading blanks. */
+static int parse_int(const char *s, long lo, long hi, int *out) {
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if ((*s != '-' && (*s < '0' || *s > '9')) || *end || errno || v < lo || v > hi) return -1;
+    *out = (int)v;
+    return 0;
+}
+
 static void usage(FILE *f) {
     fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--faults SPEC] [--rx-idle-ms N] [--break-unit UNIT] [--verbose]\n"
                "  Runs the virtual board: the firmware core with the bit-exact model as its FPGA,\n"
                "  reachable with --backend sim:ADDR.  ADDR: unix:PATH (default unix:/tmp/cbvh-board-UID.sock)\n"
-               "  or tcp:HOST:PORT.  --faults injects faults into the replies, e.g.\n"
-               "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1.\n"
+               "  or tcp:HOST:PORT (PORT 1..65535).  --faults injects faults into the replies, e.g.\n"
+               "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1\n"
+               "  (rates in [0,1] adding up to at most 1, delay_ms 0..10000, seed a non-negative integer).\n"
+               "  --rx-idle-ms N: the firmware's inter-byte timeout, 1..60000 (default 20).\n"
                "  --break-unit UNIT flips bit 0 of the unit's first output word (a test aid that\n"
                "  plays a gateware bug: checks against this board must fail).\n"
                "  Stops on SIGINT/SIGTERM and removes its socket file.\n");
@@ -39,9 +55,9 @@ int cmd_board_sim(int argc, char **argv) {
         } else if (strcmp(argv[i], "--faults") == 0 && i + 1 < argc) {
             faults = argv[++i];
         } else if (strcmp(argv[i], "--rx-idle-ms") == 0 && i + 1 < argc) {
-            idle = atoi(argv[++i]);
-            if (idle <= 0) {
-                fprintf(stderr, "cbvh board-sim: --rx-idle-ms needs a positive number\n");
+            if (parse_int(argv[++i], 1, RX_IDLE_MS_MAX, &idle)) {
+                fprintf(stderr, "cbvh board-sim: --rx-idle-ms expects an integer in 1..%d, got '%s'\n",
+                        RX_IDLE_MS_MAX, argv[i]);
                 return 2;
             }
         } else if (strcmp(argv[i], "--break-unit") == 0 && i + 1 < argc) {
@@ -67,8 +83,8 @@ int cmd_board_sim(int argc, char **argv) {
     }
     int fd = cbvh_sim_listen(addr, err, sizeof err);
     if (fd < 0) {
-        fprintf(stderr, "cbvh board-sim: %s\n", err);
-        return 1;
+        fprintf(stderr, "cbvh board-sim: %s%s\n", fd == CBVH_SIM_BAD_ADDR ? "--listen: " : "", err);
+        return fd == CBVH_SIM_BAD_ADDR ? 2 : 1; /* bad input, or the socket could not be opened */
     }
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);

@@ -28,7 +28,7 @@ static const char *bundled(const char *rel, char *buf, size_t len) {
 
 static void usage(FILE *f) {
     fprintf(f,
-            "usage: cbvh run [--backend SPEC] [--vectors DIR] [--scene FILE.scene] [--json]\n"
+            "usage: cbvh run [--backend SPEC] [--vectors DIR] [--scene SCENE] [--json]\n"
             "\n"
             "The main job: checks the golden vectors (on a board if one is attached, else on\n"
             "the bit-exact model), then traces the effects of a scene file through the float\n"
@@ -38,7 +38,8 @@ static void usage(FILE *f) {
             "\n"
             "  --backend SPEC  auto (default), model, usb, hid, sim:ADDR\n"
             "  --vectors DIR   vector directory (default: the committed vectors/)\n"
-            "  --scene FILE    scene file (default: scenes/bunny.scene; format: docs/scenes.md)\n"
+            "  --scene SCENE   scene file, or a mesh file / proc:NAME with its default scene\n"
+            "                  (default: scenes/bunny.scene; docs/scenes.md)\n"
             "  --json          one JSON object instead of tables\n");
 }
 
@@ -91,6 +92,7 @@ int cmd_run(int argc, char **argv) {
     int json = 0, c;
     char vbuf[1024], sbuf[1024], err[512];
     optind = 1;
+    opterr = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
         switch (c) {
         case 'b': backend = optarg; break;
@@ -98,7 +100,7 @@ int cmd_run(int argc, char **argv) {
         case 's': scene_path = optarg; break;
         case 'j': json = 1; break;
         case 'h': usage(stdout); return 0;
-        default: usage(stderr); return 2;
+        default: return cbvh_bad_option("cbvh run", argv, optind);
         }
     }
     if (optind != argc) {
@@ -107,6 +109,14 @@ int cmd_run(int argc, char **argv) {
     }
     if (!vec_dir) vec_dir = bundled("vectors", vbuf, sizeof vbuf);
     if (!scene_path) scene_path = bundled("scenes/bunny.scene", sbuf, sizeof sbuf);
+
+    /* The scene is loaded first: a typo in --scene is reported at once, not
+     * after a whole vector check on a board. */
+    cbvh_scene_desc d;
+    if (cbvh_scene_file_open(scene_path, &d, err, sizeof err) != 0) {
+        fprintf(stderr, "cbvh run: %s\n", err);
+        return 2;
+    }
 
     /* 1. Golden vectors. */
     cbvh_check_summary sum;
@@ -121,14 +131,12 @@ int cmd_run(int argc, char **argv) {
     if (!json) printf("== Golden vectors: %s ==\n", vec_dir);
     const char *paths[1] = {vec_dir};
     int check = cbvh_vectors_check(paths, 1, &co);
-    if (check == CBVH_CHECK_BAD_INPUT) return 2;
-
-    /* 2. Accuracy vs time on the scene. */
-    cbvh_scene_desc d;
-    if (cbvh_scene_file_load(scene_path, &d, err, sizeof err) != 0) {
-        fprintf(stderr, "cbvh run: %s\n", err);
+    if (check == CBVH_CHECK_BAD_INPUT) {
+        cbvh_scene_desc_free(&d);
         return 2;
     }
+
+    /* 2. Accuracy vs time on the scene. */
     cbvh_timing_params tp;
     cbvh_fx_timing(&d, &tp);
     width_row rows[1 + CBVH_N_MAX - CBVH_N_MIN + 1];

@@ -262,7 +262,8 @@ static void usage(FILE *f) {
                "         proc:instanced[:K] (K x K spheres, 40 -> 10.2M triangles); default: the bundled\n"
                "         bunny plus proc:cloth, proc:far, proc:wave.\n"
                "  Prints the Table-1-style study (backtracking, memory traffic of LBVH and refit,\n"
-               "  SAH cost, primitives per leaf) and the minimum-scale sweep of Fig. 10 (docs/study.md).\n");
+               "  SAH cost, primitives per leaf) and the minimum-scale sweep of Fig. 10 (docs/study.md).\n"
+               "  Exit status: 0 done, 2 bad input (an option, or a scene that cannot be loaded or built).\n");
 }
 
 int cmd_study(int argc, char **argv) {
@@ -319,7 +320,7 @@ int cmd_study(int argc, char **argv) {
         if (study_scene(specs[i], p, &res[i], err, sizeof err) ||
             (sweep && sweep_scene(specs[i], p.quant_bits, &sw[i], err, sizeof err))) {
             fprintf(stderr, "cbvh study: %s\n", err);
-            status = 1;
+            status = 2; /* bad input, as for the other commands */
             goto done;
         }
     }

@@ -68,6 +68,12 @@ static int is_int(const char *s) {
     return 1;
 }
 
+/* An empty item in a comma list ("a,,b", ",a", "a,"), which strtok would skip. */
+static int has_empty_item(const char *s) {
+    size_t n = strlen(s);
+    return n == 0 || s[0] == ',' || s[n - 1] == ',' || strstr(s, ",,") != NULL;
+}
+
 /* Values after a list option: the following arguments that are integers
  * (comma-separated lists allowed).  Returns the count, -1 on error. */
 static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, long hi, int *out, int max) {
@@ -76,7 +82,7 @@ static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, l
         const char *a = argv[*i + 1];
         char buf[256];
         snprintf(buf, sizeof buf, "%s", a);
-        int all = 1;
+        int all = !has_empty_item(a);
         for (char *t = strtok(buf, ","); t; t = strtok(NULL, ","))
             if (!is_int(t)) all = 0;
         if (!all || !*a) break;
@@ -92,6 +98,11 @@ static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, l
                 fprintf(stderr, "cbvh sweep: %s takes at most %d values\n", opt, max);
                 return -1;
             }
+            for (int k = 0; k < n; k++)
+                if (out[k] == v) { /* the same setting twice would be traced and charted twice */
+                    fprintf(stderr, "cbvh sweep: %s: %ld given twice\n", opt, v);
+                    return -1;
+                }
             out[n++] = (int)v;
         }
     }
@@ -351,7 +362,7 @@ int cmd_sweep(int argc, char **argv) {
             const char *v = i + 1 < argc ? argv[++i] : "";
             char buf[512], ferr[200] = "";
             size_t len = strlen(v);
-            int cb = 0, bad = len >= sizeof buf || !*v;
+            int cb = 0, bad = len >= sizeof buf || has_empty_item(v);
             if (!bad) memcpy(buf, v, len + 1);
             o.nextra = 0;
             for (char *t = strtok(buf, ","); t && !bad; t = strtok(NULL, ",")) {
@@ -476,7 +487,7 @@ int cmd_sweep(int argc, char **argv) {
         if (tty) fprintf(stderr, "\n");
         fprintf(stderr, "cbvh sweep: %s: %s\n", scene, err);
         cbvh_scene_desc_free(&d);
-        return 1;
+        return 2; /* the run could not be done: not a finding about hits */
     }
     if (tty) fprintf(stderr, "\r%70s\r", "");
 
@@ -527,7 +538,7 @@ int cmd_sweep(int argc, char **argv) {
         if (cbvh_svg_chart(path, title, "coordinate bits N", "cost / float BVH", x, (size_t)nb, ser, 4, err,
                            sizeof err)) {
             fprintf(stderr, "cbvh sweep: %s\n", err);
-            status = status ? status : 1;
+            status = status ? status : 2; /* an output file not written */
         } else
             snprintf(written[nwritten++], sizeof written[0], "%s", path);
     }
@@ -565,14 +576,14 @@ int cmd_sweep(int argc, char **argv) {
         if (cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res.width, (unsigned)res.height, 0, vmax, 0, &used_min,
                              &used_max, err, sizeof err)) {
             fprintf(stderr, "cbvh sweep: %s\n", err);
-            status = status ? status : 1;
+            status = status ? status : 2; /* an output file not written */
         } else if (nwritten < 16)
             snprintf(written[nwritten++], sizeof written[0], "%s", path);
     }
     snprintf(path, sizeof path, "%s/render-float.png", outdir);
     if (cbvh_png_write(path, res.ref.image, (unsigned)res.width, (unsigned)res.height, 1, err, sizeof err)) {
         fprintf(stderr, "cbvh sweep: %s\n", err);
-        status = status ? status : 1;
+        status = status ? status : 2;
     } else if (nwritten < 16)
         snprintf(written[nwritten++], sizeof written[0], "%s", path);
 

@@ -245,7 +245,7 @@ int cmd_trace(int argc, char **argv) {
         if (pc.last_row) fprintf(stderr, "\n");
         fprintf(stderr, "cbvh trace: %s: %s\n", scene, err);
         cbvh_scene_desc_free(&d);
-        return 1;
+        return 2; /* the run could not be done: not a finding about hits */
     }
     const cbvh_fx_result *main_r = &rf;
     int cmp = fmt != CBVH_FORMAT_FLOAT; /* a format compared against the float BVH */
@@ -257,7 +257,7 @@ int cmd_trace(int argc, char **argv) {
             if (pc.last_row) fprintf(stderr, "\n");
             fprintf(stderr, "cbvh trace: %s: %s\n", scene, err);
             cbvh_scene_desc_free(&d);
-            return 1;
+            return 2; /* the run could not be done: not a finding about hits */
         }
         main_r = &rc;
         if (rc.hit_digest != rf.hit_digest) status = 1; /* every format must return the float BVH's hits */

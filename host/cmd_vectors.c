@@ -121,6 +121,7 @@ static int cmd_gen(int argc, char **argv) {
     int c;
     long v;
     optind = 0;
+    opterr = 0;
     while ((c = getopt_long(argc, argv, "u:l:s:n:m:e:o:h", lo, NULL)) != -1) {
         switch (c) {
         case 'u':
@@ -172,7 +173,7 @@ static int cmd_gen(int argc, char **argv) {
             break;
         case 'o': dir = optarg; break;
         case 'h': usage_gen(stdout); return 0;
-        default: usage_gen(stderr); return 2;
+        default: return cbvh_bad_option("cbvh vectors gen", argv, optind);
         }
     }
     if (optind < argc) {
@@ -191,6 +192,11 @@ static int cmd_gen(int argc, char **argv) {
         fprintf(stderr, "cbvh vectors gen: cannot create %s: %s\n", dir, strerror(errno));
         return 2;
     }
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "cbvh vectors gen: %s exists and is not a directory\n", dir);
+        return 2;
+    }
     size_t n = cbvh_vecgen_specs(&sel, NULL, 0);
     cbvh_vecgen_spec *specs = calloc(n ? n : 1, sizeof *specs);
     if (!specs) return 2;
@@ -204,7 +210,7 @@ static int cmd_gen(int argc, char **argv) {
         free(specs);
         return 2;
     }
-    size_t total = 0;
+    size_t total = 0, written = 0;
     int rc = 0;
     for (size_t i = 0; i < n && rc == 0; i++) {
         char name[256], hex[CBVH_SHA256_HEX_LEN + 1];
@@ -218,12 +224,16 @@ static int cmd_gen(int argc, char **argv) {
         if (write_vecfile(dir, name, &vf, hex, err, sizeof err) != 0 || cbvh_manifest_set(&m, name, hex) != 0) {
             fprintf(stderr, "cbvh vectors gen: %s\n", err);
             rc = 2;
+        } else {
+            written++;
         }
         total += vf.count;
         cbvh_vecfile_free(&vf);
     }
-    /* The manifest vouches for what was written; entries of other files stay. */
-    if (cbvh_manifest_save(dir, &m, err, sizeof err) != 0) {
+    /* The manifest vouches for what was written; entries of other files stay.
+     * Nothing written: the manifest stays as it was (no empty MANIFEST left
+     * behind by a failed first run). */
+    if (written && cbvh_manifest_save(dir, &m, err, sizeof err) != 0) {
         fprintf(stderr, "cbvh vectors gen: %s\n", err);
         rc = 2;
     }
@@ -244,6 +254,7 @@ static int cmd_check(int argc, char **argv) {
     int c;
     long v;
     optind = 0;
+    opterr = 0;
     while ((c = getopt_long(argc, argv, "b:M:jqh", lo, NULL)) != -1) {
         switch (c) {
         case 'b': o.backend = optarg; break;
@@ -257,7 +268,7 @@ static int cmd_check(int argc, char **argv) {
         case 'j': o.json = 1; break;
         case 'q': o.quiet = 1; break;
         case 'h': usage_check(stdout); return 0;
-        default: usage_check(stderr); return 2;
+        default: return cbvh_bad_option("cbvh vectors check", argv, optind);
         }
     }
     if (optind >= argc) {

@@ -13,4 +13,9 @@ int cmd_study(int argc, char **argv);     /* cmd_study.c: backtracking/memory-tr
 int cmd_trace(int argc, char **argv);     /* cmd_trace.c: trace the effects a scene file calls for (issue 4) */
 int cmd_sweep(int argc, char **argv);     /* cmd_sweep.c: accuracy vs time over N x M x min scale (issue 4) */
 
+/* getopt_long reported an unknown option or a missing value (call with
+ * opterr = 0): one line naming it, instead of getopt's own message (which
+ * names the subcommand as if it were the program) and the whole usage. */
+int cbvh_bad_option(const char *cmd, char **argv, int optind_now); /* main.c; returns 2 */
+
 #endif

@@ -5,6 +5,7 @@
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include "effects.h"
 
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -398,10 +399,22 @@ int cbvh_tlist_opts_parse(const char *s, cbvh_tlist_opts *t, char *err, size_t e
         return -1;
     }
     snprintf(buf, sizeof buf, "%s", s + 5);
-    /* Split on ':' by hand: callers may be inside their own strtok loop. */
+    /* Split on ':' by hand: callers may be inside their own strtok loop.  Each
+     * group (count, order, cull, heads) at most once: "tlist:6:2" would
+     * otherwise silently mean 2. */
+    int seen[4] = {0, 0, 0, 0};
     for (char *k = buf[0] ? buf + 1 : NULL, *next; k; k = next) {
         next = strchr(k, ':');
         if (next) *next++ = 0;
+        int group = isdigit((unsigned char)k[0]) ? 0 : strcmp(k, "earliest") == 0 || strcmp(k, "latest") == 0 ? 1
+                    : strcmp(k, "cull") == 0                                                             ? 2
+                    : strcmp(k, "heads") == 0                                                            ? 3
+                                                                                                           : -1;
+        if (group >= 0 && seen[group]++) {
+            static const char *const what[4] = {"a list count", "an order", "cull", "heads"};
+            snprintf(err, errlen, "format '%s': %s given twice", s, what[group]);
+            return -1;
+        }
         if (strcmp(k, "1") == 0 || strcmp(k, "2") == 0 || strcmp(k, "6") == 0 || strcmp(k, "8") == 0)
             t->p.nlists = k[0] - '0';
         else if (strcmp(k, "earliest") == 0)
@@ -499,9 +512,15 @@ static int build_tlists(tracer *T, char *err, size_t errlen) {
                 for (int a = 0; a < 3; a++) cmax = fmaxf(cmax, fabsf(sc.tris[i].v[v][a]));
         cmax += T->eps;
         for (int a = 0; a < 3; a++) cmax = fmaxf(cmax, fabsf(c->position[a]) + fabsf(c->aperture));
-        if (cbvh_tlists_poly_heads(&T->tl, T->tris, CBVH_TLIST_HEADS_REGULAR, cbvh_tlist_hitpoint_margin(T->eps, cmax),
-                                   err, errlen))
+        float margin = cbvh_tlist_hitpoint_margin(T->eps, cmax);
+        if (!isfinite(margin)) { /* coordinates near FLT_MAX: no binary32 margin covers the hit points */
+            snprintf(err, errlen,
+                     "tlist heads: coordinates up to %g leave no finite margin for the per-polygon heads "
+                     "(docs/tlist.md 7.1); trace without :heads",
+                     (double)cmax);
             return -1;
+        }
+        if (cbvh_tlists_poly_heads(&T->tl, T->tris, CBVH_TLIST_HEADS_REGULAR, margin, err, errlen)) return -1;
     }
     return build_cell_heads(T, err, errlen);
 }

@@ -50,6 +50,7 @@ static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned 
         free(tmp);
         return -1;
     }
+    errno = 0; /* so a failed write below can be named (e.g. no space left) */
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     volatile int ok = 0;
@@ -74,8 +75,9 @@ static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned 
     png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
     int werr = ferror(f);
     if (fclose(f) != 0) werr = 1;
-    if (!ok || werr) {
-        snprintf(err, errlen, "png: writing %s failed%s", path, ok ? ": I/O error" : " (libpng error)");
+    if (!ok || werr) { /* errno from the failed flush, e.g. no space left */
+        snprintf(err, errlen, "png: writing %s failed: %s", path,
+                 !ok ? "libpng error" : errno ? strerror(errno) : "I/O error");
         unlink(tmp);
         free(tmp);
         return -1;

@@ -1,4 +1,5 @@
 /* cbvh: host tool of the low-precision ray-tracing accelerator kit. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -26,6 +27,27 @@ static void usage(FILE *f) {
         fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
 }
 
+int cbvh_bad_option(const char *cmd, char **argv, int optind_now) {
+    const char *arg = optind_now > 0 ? argv[optind_now - 1] : "";
+    fprintf(stderr, "%s: unknown option or missing value: '%s' (see %s --help)\n", cmd, arg, cmd);
+    return 2;
+}
+
+/* Results go to stdout, often redirected: a full disk or a closed pipe must
+ * not pass as success with the table or JSON lost.  Exit 2 unless the command
+ * already failed. */
+static int finish_stdout(int rc) {
+    errno = 0;
+    int bad = ferror(stdout);
+    if (fclose(stdout) != 0) bad = 1;
+    if (bad) {
+        fprintf(stderr, "cbvh: cannot write the output to standard output: %s\n",
+                errno ? strerror(errno) : "write error");
+        return rc ? rc : 2;
+    }
+    return rc;
+}
+
 int main(int argc, char **argv) {
     if (argc < 2) {
         usage(stderr);
@@ -33,14 +55,14 @@ int main(int argc, char **argv) {
     }
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
         usage(stdout);
-        return 0;
+        return finish_stdout(0);
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("cbvh %s\n", CBVH_VERSION);
-        return 0;
+        return finish_stdout(0);
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (strcmp(argv[1], commands[i].name) == 0) return commands[i].fn(argc - 1, argv + 1);
+        if (strcmp(argv[1], commands[i].name) == 0) return finish_stdout(commands[i].fn(argc - 1, argv + 1));
     fprintf(stderr, "cbvh: unknown command '%s'\n", argv[1]);
     usage(stderr);
     return 2;

@@ -1,6 +1,7 @@
 /* Host side of the board protocol: see protocol.h and docs/protocol.md. */
 #include "protocol.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,10 +25,32 @@ void cbvh_link_init(cbvh_link *l, const cbvh_link_io *io) {
     cbvh_parser_init(&l->rx);
 }
 
-void cbvh_link_env_options(cbvh_link *l) {
-    const char *t = getenv("CBVH_LINK_TIMEOUT_MS"), *r = getenv("CBVH_LINK_RETRIES");
-    if (t && atoi(t) > 0) l->timeout_ms = atoi(t);
-    if (r && atoi(r) >= 0) l->max_retries = atoi(r);
+/* One integer setting from the environment: unset or empty keeps *v; anything
+ * but a plain decimal in lo..hi is an error (atoi took "5x" as 5). */
+static int env_int(const char *name, long lo, long hi, int *v, char *err, size_t errlen) {
+    const char *s = getenv(name);
+    if (!s || !*s) return 0;
+    char *end;
+    errno = 0;
+    long x = strtol(s, &end, 10);
+    if (*s < '0' || *s > '9' || *end || errno || x < lo || x > hi) {
+        snprintf(err, errlen, "%s='%.40s' is not valid (expected an integer in %ld..%ld)", name, s, lo, hi);
+        return -1;
+    }
+    *v = (int)x;
+    return 0;
+}
+
+int cbvh_link_env_options(cbvh_link *l, char *err, size_t errlen) {
+    int t = CBVH_LINK_TIMEOUT_MS_DEFAULT, r = CBVH_LINK_RETRIES_DEFAULT;
+    if (env_int("CBVH_LINK_TIMEOUT_MS", 1, CBVH_LINK_TIMEOUT_MS_MAX, &t, err, errlen) ||
+        env_int("CBVH_LINK_RETRIES", 0, CBVH_LINK_RETRIES_MAX, &r, err, errlen))
+        return -1;
+    if (l) {
+        l->timeout_ms = t;
+        l->max_retries = r;
+    }
+    return 0;
 }
 
 void cbvh_link_flush(cbvh_link *l, int quiet_ms) {
@@ -175,11 +198,14 @@ int cbvh_link_identify(cbvh_link *l, char *err, size_t errlen) {
     return 0;
 }
 
-size_t cbvh_link_max_batch(int n_in, int n_out) {
-    size_t a = (CBVH_FRAME_MAX_PAYLOAD - RUN_HDR) / (4u * (size_t)n_in);
-    size_t b = (CBVH_FRAME_MAX_PAYLOAD - RUN_REPLY_HDR) / (4u * (size_t)n_out);
+/* Vectors per RUN frame when neither request nor reply may exceed max_payload. */
+static size_t batch_limit(size_t max_payload, int n_in, int n_out) {
+    size_t a = (max_payload - RUN_HDR) / (4u * (size_t)n_in);
+    size_t b = (max_payload - RUN_REPLY_HDR) / (4u * (size_t)n_out);
     return a < b ? a : b;
 }
+
+size_t cbvh_link_max_batch(int n_in, int n_out) { return batch_limit(CBVH_FRAME_MAX_PAYLOAD, n_in, n_out); }
 
 int cbvh_run_reply_check(const uint8_t *p, size_t len, uint8_t unit, unsigned count, unsigned n_out) {
     if (len < RUN_REPLY_HDR) return -1;
@@ -202,7 +228,15 @@ int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *c
                  cfg->params.quant_bits, cfg->params.min_scale);
         return -1;
     }
-    size_t max = cbvh_link_max_batch(lay.n_in, lay.n_out);
+    /* The board may take smaller frames than the protocol allows (IDENTIFY's
+     * max payload, at least 64): batches are cut to what it said. */
+    size_t cap = l->ident.max_payload ? l->ident.max_payload : CBVH_FRAME_MAX_PAYLOAD;
+    size_t max = batch_limit(cap, lay.n_in, lay.n_out);
+    if (max == 0) {
+        snprintf(err, errlen, "unit %s (%d->%d words) does not fit the board's %zu-byte frames", unit->name,
+                 lay.n_in, lay.n_out, cap);
+        return -1;
+    }
     uint8_t *payload = l->req;
     for (size_t done = 0; done < count;) {
         size_t k = count - done < max ? count - done : max;

@@ -58,6 +58,8 @@ typedef struct {
 
 #define CBVH_LINK_TIMEOUT_MS_DEFAULT 1000
 #define CBVH_LINK_RETRIES_DEFAULT 8
+#define CBVH_LINK_TIMEOUT_MS_MAX 600000
+#define CBVH_LINK_RETRIES_MAX 1000
 
 void cbvh_link_init(cbvh_link *l, const cbvh_link_io *io);
 /* Drops whatever the board still has in flight (after open/reopen). */
@@ -70,9 +72,11 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
                        char *err, size_t errlen);
 
 int cbvh_link_identify(cbvh_link *l, char *err, size_t errlen);
-/* Largest number of vectors of this shape in one RUN frame. */
+/* Largest number of vectors of this shape in one RUN frame of the protocol's
+ * largest size (a board may report less: cbvh_link_run honours that). */
 size_t cbvh_link_max_batch(int n_in, int n_out);
-/* Runs count vectors, split into as many frames as needed.  out is written
+/* Runs count vectors, split into as many frames as needed (no larger than
+ * the max payload the board reported in IDENTIFY).  out is written
  * only from validated replies; 0 or -1 with err set. */
 int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out,
                   size_t count, char *err, size_t errlen);
@@ -82,7 +86,10 @@ int cbvh_run_reply_check(const uint8_t *p, size_t len, uint8_t unit, unsigned co
 /* Parses an IDENTIFY reply payload: 0 or -1 (fuzzed). */
 int cbvh_identity_parse(const uint8_t *p, size_t len, cbvh_identity *id);
 
-/* Timeout and retries from CBVH_LINK_TIMEOUT_MS / CBVH_LINK_RETRIES. */
-void cbvh_link_env_options(cbvh_link *l);
+/* Timeout and retries from CBVH_LINK_TIMEOUT_MS (1..CBVH_LINK_TIMEOUT_MS_MAX)
+ * and CBVH_LINK_RETRIES (0..CBVH_LINK_RETRIES_MAX); unset or empty keeps the
+ * defaults.  0, or -1 with err naming the variable and the accepted form (l is
+ * then untouched).  l may be NULL: only check the variables. */
+int cbvh_link_env_options(cbvh_link *l, char *err, size_t errlen);
 
 #endif

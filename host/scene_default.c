@@ -2,6 +2,7 @@
  * file"): what `cbvh trace` and `cbvh sweep` use when given a mesh file or
  * proc:NAME instead of a scene file, so the per-mesh figures of
  * docs/results.md come from one command each. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -93,10 +94,32 @@ int cbvh_scene_file_default(const char *mesh, cbvh_scene_desc *d, char *err, siz
         d->lights[0].position[a] = c[a] + light_off[a] * ext;
     }
     d->effect[CBVH_FX_AMBIENT_OCCLUSION].distance = 0.2f * ext;
+    /* A mesh spanning most of binary32 (|x| near 3e38) puts the floor, camera
+     * and light beyond it; say so here rather than let the scene check blame
+     * a floor triangle the user never wrote. */
+    int finite = isfinite(ext);
+    for (uint32_t t = d->mesh_tris; t < d->mesh.ntris; t++)
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) finite &= isfinite(d->mesh.tris[t].v[v][a]) != 0;
+    for (int a = 0; a < 3; a++)
+        finite &= isfinite(d->camera.position[a]) && isfinite(d->lights[0].position[a]);
+    if (!finite) {
+        snprintf(err, errlen,
+                 "%s: the mesh is too large for its default scene (extent %g: the floor, camera or light would "
+                 "overflow binary32); write a scene file for it",
+                 mesh, (double)ext);
+        cbvh_scene_desc_free(d);
+        return -1;
+    }
     return 0;
 }
 
 int cbvh_scene_file_open(const char *arg, cbvh_scene_desc *d, char *err, size_t errlen) {
+    if (!*arg) { /* e.g. an unset shell variable: "" would be reported as a scene file without a path */
+        memset(d, 0, sizeof *d);
+        snprintf(err, errlen, "empty scene argument (a scene file, a mesh file or proc:NAME)");
+        return -1;
+    }
     return arg_is_mesh(arg) ? cbvh_scene_file_default(arg, d, err, errlen)
                                        : cbvh_scene_file_load(arg, d, err, errlen);
 }

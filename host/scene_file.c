@@ -13,6 +13,7 @@
 #include <cjson/cJSON.h>
 
 #include "scene_load.h"
+#include "timing_model.h"
 
 static const char *const fx_names[CBVH_FX_COUNT] = {"primary",          "hard_shadows", "soft_shadows",
                                                     "ambient_occlusion", "mirror",       "diffuse_bounce"};
@@ -38,18 +39,20 @@ static int fail(pctx *c, const char *field, const char *fmt, ...) {
     return -1;
 }
 
-/* Every key of obj must be in the NULL-terminated list. */
+/* Every key of obj must be in the NULL-terminated list, and appear once (cJSON
+ * keeps both copies of a repeated key and lookups see the first: the second
+ * would be silently ignored). */
 static int check_keys(pctx *c, const cJSON *obj, const char *field, const char *const *allowed) {
     const cJSON *it;
     cJSON_ArrayForEach(it, obj) {
         int ok = 0;
         for (const char *const *a = allowed; *a; a++)
             if (strcmp(*a, it->string) == 0) ok = 1;
-        if (!ok) {
-            char f[160];
-            snprintf(f, sizeof f, "%s%s%s", field, *field ? "." : "", it->string);
-            return fail(c, f, "unknown field");
-        }
+        char f[160];
+        snprintf(f, sizeof f, "%s%s%s", field, *field ? "." : "", it->string);
+        if (!ok) return fail(c, f, "unknown field");
+        for (const cJSON *p = obj->child; p != it; p = p->next)
+            if (strcmp(p->string, it->string) == 0) return fail(c, f, "given twice");
     }
     return 0;
 }
@@ -69,7 +72,7 @@ static int get_num(pctx *c, const cJSON *obj, const char *parent, const char *ke
         return fail(c, f, "expected a number %s%g, %g]", lo_open ? "in (" : "in [", lo, hi);
     double x = it->valuedouble;
     if (x < lo || (lo_open && x == lo) || x > hi)
-        return fail(c, f, "%g is out of range %s%g, %g]", x, lo_open ? "(" : "[", lo, hi);
+        return fail(c, f, "%.9g is out of range %s%g, %g]", x, lo_open ? "(" : "[", lo, hi);
     *v = x;
     return 1;
 }
@@ -362,8 +365,8 @@ static int parse_timing(pctx *c, const cJSON *t, cbvh_scene_desc *d) {
     double *dst[] = {&d->timing.box_cycles, &d->timing.tri_cycles, &d->timing.fetch_latency,
                      &d->timing.dram_bytes_per_cycle, &d->timing.clock_mhz};
     for (int i = 0; keys[i]; i++) {
-        int lo_open = i >= 3; /* bandwidth and clock must be > 0 */
-        if (get_num(c, t, "timing", keys[i], 0, lo_open, 1e9, dst[i], 0) < 0) return -1;
+        double lo = i >= 3 ? CBVH_TIMING_RATE_MIN : 0; /* bandwidth and clock: a rate, bounded away from 0 */
+        if (get_num(c, t, "timing", keys[i], lo, 0, CBVH_TIMING_MAX, dst[i], 0) < 0) return -1;
     }
     return 0;
 }

@@ -1,13 +1,16 @@
 /* Mesh import through assimp's C API (one-line errors, nothing partial). */
+#define _POSIX_C_SOURCE 200809L /* getline, stat */
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "scene_load.h"
 
@@ -116,87 +119,503 @@ static int load_morph_keys(const struct aiScene *sc, cbvh_scene *s) {
     return 0;
 }
 
-/* Next non-empty, non-comment line of f into buf; 0 at end of file. */
-static int off_line(FILE *f, char *buf, size_t n) {
-    while (fgets(buf, (int)n, f)) {
-        char *h = strchr(buf, '#');
-        if (h) *h = 0;
-        char *p = buf;
-        while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n') p++;
-        if (*p) return 1;
-    }
-    return 0;
+/* Lines of a text mesh file, numbered for messages (getline: no length limit,
+ * so a long face line is never split in two). */
+typedef struct {
+    FILE *f;
+    char *buf;
+    size_t cap;
+    long lineno;
+    int lf_only; /* the last line ended in a bare "\n" (not "\r\n") */
+} line_reader;
+
+/* The next line as it is, or NULL at the end of the file. */
+static char *raw_line(line_reader *r) {
+    ssize_t n = getline(&r->buf, &r->cap, r->f);
+    if (n < 0) return NULL;
+    r->lineno++;
+    r->lf_only = r->buf[n - 1] == '\n' && !(n >= 2 && r->buf[n - 2] == '\r');
+    return r->buf;
 }
 
-/* assimp's OFF reader clamps out-of-range face indices to the last vertex
- * (silently changing the mesh), so OFF files get their indices checked here.
- * 0, or -1 with a message. */
-static int off_check_indices(const char *path, char *err, size_t errlen) {
+/* The next line with content ('#' comments removed when hash_comments), or
+ * NULL at the end of the file. */
+static char *next_line(line_reader *r, int hash_comments) {
+    while (raw_line(r)) {
+        if (hash_comments) {
+            char *h = strchr(r->buf, '#');
+            if (h) *h = 0;
+        }
+        char *p = r->buf;
+        while (isspace((unsigned char)*p)) p++;
+        if (*p) return r->buf;
+    }
+    return NULL;
+}
+
+/* The next whitespace-separated token of the line at *p, terminated in
+ * place; NULL at the end of the line. */
+static char *next_token(char **p) {
+    char *s = *p;
+    while (isspace((unsigned char)*s)) s++;
+    if (!*s) {
+        *p = s;
+        return NULL;
+    }
+    char *e = s;
+    while (*e && !isspace((unsigned char)*e)) e++;
+    if (*e) *e++ = 0;
+    *p = e;
+    return s;
+}
+
+static int token_is_int(const char *t, long long *v) {
+    char *end;
+    errno = 0;
+    *v = strtoll(t, &end, 10);
+    return end != t && !*end && errno != ERANGE;
+}
+
+/* A decimal real ("nan"/"inf" too: the finiteness check reports those with
+ * the triangle).  Hex floats are refused: the importers read "0x1p3" as 0. */
+static int token_is_real(const char *t) {
+    char *end;
+    (void)strtod(t, &end);
+    return end != t && !*end && !strpbrk(t, "xX");
+}
+
+/* An OFF body line: NULL at the end of the file, else the line with its
+ * '#' comment cut off; *empty = 1 when only line ends (assimp skips those),
+ * 2 when only spaces or a comment (assimp reads that as a record). */
+static char *off_body_line(line_reader *r, int *empty) {
+    char *p = raw_line(r);
+    if (!p) return NULL;
+    *empty = p[strspn(p, "\r\n")] == 0;
+    char *h = strchr(p, '#');
+    if (h) *h = 0;
+    if (!*empty) {
+        while (isspace((unsigned char)*p)) p++;
+        *empty = *p ? 0 : 2;
+    }
+    return r->buf;
+}
+
+/* assimp's OFF reader takes each line after the counts as one record: it
+ * clamps out-of-range face indices to the last vertex, reads a short face
+ * line, a non-number, or a comment or blank-with-spaces line among the
+ * records as something else, skips faces of 0 or more than 9 vertices and
+ * ignores records beyond the counts (each silently changing the mesh), so OFF
+ * files get their records checked here.  0, or -1 with a message. */
+static int off_check(const char *path, char *err, size_t errlen) {
     const char *dot = strrchr(path, '.');
     if (!dot || strcasecmp(dot, ".off") != 0) return 0;
     FILE *f = fopen(path, "r");
     if (!f) return 0; /* the importer reports it */
-    char line[4096];
-    long nv = -1, nf = -1;
-    int rc = 0;
-    if (off_line(f, line, sizeof line)) {
-        char *p = line;
-        while (*p == ' ' || *p == '\t') p++;
-        if (strncmp(p, "OFF", 3) == 0 || strstr(p, "OFF")) { /* header, counts may follow on the same line */
-            p = strstr(p, "OFF") + 3;
-            if (sscanf(p, "%ld %ld", &nv, &nf) != 2 && off_line(f, line, sizeof line))
-                sscanf(line, "%ld %ld", &nv, &nf);
-        } else {
-            sscanf(p, "%ld %ld", &nv, &nf);
-        }
+    line_reader r = {f, NULL, 0, 0, 0};
+    long long count[3] = {0, 0, 0}; /* vertices, faces, edges */
+    int rc = 0, got = 0, empty;
+    char *line = next_line(&r, 1), *p, *t;
+    if (!line) goto done; /* the importer reports it */
+    /* [ST][C][N]OFF, then the counts on the same or the next line; header-less
+     * files start with the counts */
+    p = line + strspn(line, " \t");
+    size_t kw = strcspn(p, " \t\r\n");
+    if (kw >= 3 && strncmp(p + kw - 3, "OFF", 3) == 0) {
+        if (memchr(p, '4', kw) || memchr(p, 'n', kw)) goto done; /* 4OFF, nOFF: not checked here */
+        p += kw;
+        if (!p[strspn(p, " \t\r\n")] && !(p = next_line(&r, 1))) goto done;
     }
-    if (nv < 0 || nf < 0) goto done; /* malformed header: the importer reports it */
-    for (long i = 0; i < nv; i++)
-        if (!off_line(f, line, sizeof line)) goto done;
-    for (long i = 0; i < nf && rc == 0; i++) {
-        if (!off_line(f, line, sizeof line)) break;
-        char *p = line, *end;
-        long k = strtol(p, &end, 10);
-        p = end;
-        for (long j = 0; j < k; j++) {
-            long idx = strtol(p, &end, 10);
-            if (end == p) break;
-            p = end;
+    while (got < 3 && (t = next_token(&p)) && token_is_int(t, &count[got]) && count[got] >= 0) got++;
+    if (got < 3) {
+        snprintf(err, errlen, "'%s' line %ld: the OFF header needs vertex, face and edge counts", path, r.lineno);
+        rc = -1;
+        goto done;
+    }
+    long long nv = count[0], nf = count[1];
+    for (long long i = 0; i < nv + nf && rc == 0;) {
+        if (!(line = off_body_line(&r, &empty))) {
+            snprintf(err, errlen, "'%s': the header declares %lld vertices and %lld faces, the file ends after %lld",
+                     path, nv, nf, i);
+            rc = -1;
+            break;
+        }
+        if (empty == 1 || (empty && i == 0)) continue; /* before the first record assimp skips comments too */
+        if (empty) {
+            snprintf(err, errlen, "'%s' line %ld: a comment or blank line among the records (read as a record)", path,
+                     r.lineno);
+            rc = -1;
+            break;
+        }
+        p = line;
+        if (i < nv) { /* x y z, then optional normal, colour etc. */
+            for (int a = 0; a < 3 && rc == 0; a++) {
+                if (!(t = next_token(&p))) {
+                    snprintf(err, errlen, "'%s' line %ld: vertex %lld has %d coordinates, 3 needed", path, r.lineno, i,
+                             a);
+                    rc = -1;
+                } else if (!token_is_real(t)) {
+                    snprintf(err, errlen, "'%s' line %ld: vertex %lld: coordinate '%.32s' is not a number", path,
+                             r.lineno, i, t);
+                    rc = -1;
+                }
+            }
+            i++;
+            continue;
+        }
+        long long face = i - nv, k, idx;
+        if (!(t = next_token(&p)) || !token_is_int(t, &k)) {
+            snprintf(err, errlen, "'%s' line %ld: face %lld: vertex count '%.32s' is not an integer", path, r.lineno,
+                     face, t ? t : "");
+            rc = -1;
+            break;
+        }
+        if (k < 1 || k > 9) {
+            snprintf(err, errlen, "'%s' line %ld: face %lld has %lld vertices (the OFF importer takes 1 to 9)", path,
+                     r.lineno, face, k);
+            rc = -1;
+            break;
+        }
+        for (long long j = 0; j < k; j++) { /* the indices; a colour may follow */
+            if (!(t = next_token(&p))) {
+                snprintf(err, errlen, "'%s' line %ld: face %lld declares %lld vertices but lists %lld", path,
+                         r.lineno, face, k, j);
+                rc = -1;
+                break;
+            }
+            if (!token_is_int(t, &idx)) {
+                snprintf(err, errlen, "'%s' line %ld: face %lld: vertex index '%.32s' is not a number", path, r.lineno,
+                         face, t);
+                rc = -1;
+                break;
+            }
             if (idx < 0 || idx >= nv) {
-                snprintf(err, errlen, "'%s' face %ld: vertex index %ld out of range (%ld vertices)", path, i, idx, nv);
+                snprintf(err, errlen, "'%s' line %ld: face %lld: vertex index %lld out of range (%lld vertices)", path,
+                         r.lineno, face, idx, nv);
                 rc = -1;
                 break;
             }
         }
+        i++;
     }
+    while (rc == 0 && (line = off_body_line(&r, &empty)))
+        if (!empty) {
+            snprintf(err, errlen, "'%s' line %ld: more records than the header's %lld vertices and %lld faces", path,
+                     r.lineno, nv, nf);
+            rc = -1;
+        }
 done:
+    free(r.buf);
     fclose(f);
     return rc;
 }
 
+/* ---- PLY ----------------------------------------------------------------
+ * assimp's PLY reader trusts the header's counts: with fewer records than
+ * declared it invents faces, with more vertex lines it reads a vertex as a
+ * face, and it allocates a claimed 4e9 vertices before reading any (then
+ * std::bad_alloc).  So the header is parsed here and the body checked
+ * against it: ASCII record by record, binary by its minimum size.  Layouts
+ * this check does not know go to assimp unchanged. */
+
+enum { PLY_MAX_ELEMENTS = 16, PLY_MAX_PROPS = 64 };
+
+typedef struct {
+    int is_list;
+    int count_size, item_size; /* bytes (binary); count_size only for lists */
+    int item_is_real;          /* float/double: else integers only (ASCII) */
+    int is_face_index;         /* the face element's vertex_indices list */
+} ply_prop;
+
+typedef struct {
+    char name[32];
+    unsigned long long count;
+    int nprops;
+    ply_prop props[PLY_MAX_PROPS];
+} ply_element;
+
+typedef struct {
+    int binary;
+    int nelem;
+    ply_element elem[PLY_MAX_ELEMENTS];
+    long body; /* file offset of the first record */
+} ply_header;
+
+/* Size in bytes of a PLY scalar type (assimp's names), 0 if unknown. */
+static int ply_type_size(const char *t, int *is_real) {
+    static const struct {
+        const char *name;
+        int size, real;
+    } types[] = {{"char", 1, 0},   {"int8", 1, 0},    {"uchar", 1, 0},   {"uint8", 1, 0},    {"short", 2, 0},
+                 {"int16", 2, 0},  {"ushort", 2, 0},  {"uint16", 2, 0},  {"int", 4, 0},      {"int32", 4, 0},
+                 {"uint", 4, 0},   {"uint32", 4, 0},  {"float", 4, 1},   {"float32", 4, 1},  {"double", 8, 1},
+                 {"float64", 8, 1}, {"double64", 8, 1}};
+    for (size_t i = 0; t && i < sizeof types / sizeof types[0]; i++)
+        if (strcmp(t, types[i].name) == 0) {
+            *is_real = types[i].real;
+            return types[i].size;
+        }
+    return 0;
+}
+
+/* Parse the header from the start of f.  1: parsed into h; 0: a layout this
+ * check does not know (assimp decides); -1: provably wrong (message). */
+static int ply_parse_header(const char *path, line_reader *r, ply_header *h, char *err, size_t errlen) {
+    memset(h, 0, sizeof *h);
+    char *p = next_line(r, 0), *t;
+    if (!p || !(t = next_token(&p)) || strcasecmp(t, "ply") != 0 || next_token(&p)) return 0;
+    /* assimp wants the format on the second line */
+    p = next_line(r, 0);
+    if (!p || !(t = next_token(&p)) || strcmp(t, "format") != 0 || !(t = next_token(&p))) return 0;
+    if (strcmp(t, "ascii") == 0)
+        h->binary = 0;
+    else if (strcmp(t, "binary_little_endian") == 0 || strcmp(t, "binary_big_endian") == 0)
+        h->binary = 1;
+    else
+        return 0;
+    ply_element *e = NULL;
+    while ((p = next_line(r, 0))) {
+        t = next_token(&p);
+        if (strcmp(t, "end_header") == 0) {
+            h->body = ftell(r->f);
+            return h->body < 0 ? 0 : 1;
+        }
+        if (strcmp(t, "element") == 0) {
+            char *name = next_token(&p), *count = next_token(&p);
+            if (!name || strcmp(name, "TextureFile") == 0 || h->nelem == PLY_MAX_ELEMENTS) return 0;
+            e = &h->elem[h->nelem++];
+            snprintf(e->name, sizeof e->name, "%s", name);
+            long long n;
+            if (!count || !token_is_int(count, &n) || n < 0 || n > 0xFFFFFFFFll) {
+                snprintf(err, errlen, "'%s' line %ld: element '%.32s' count '%.32s' is not an integer in 0..4294967295",
+                         path, r->lineno, name, count ? count : "");
+                return -1;
+            }
+            e->count = (unsigned long long)n;
+        } else if (strcmp(t, "property") == 0) {
+            if (!e || e->nprops == PLY_MAX_PROPS) return 0;
+            ply_prop *pr = &e->props[e->nprops++];
+            char *type = next_token(&p), *name;
+            if (type && strcmp(type, "list") == 0) {
+                int count_real;
+                pr->is_list = 1;
+                pr->count_size = ply_type_size(next_token(&p), &count_real);
+                pr->item_size = ply_type_size(next_token(&p), &pr->item_is_real);
+                if (!pr->count_size || count_real || !pr->item_size) return 0;
+            } else if (!(pr->item_size = ply_type_size(type, &pr->item_is_real))) {
+                return 0;
+            }
+            if (!(name = next_token(&p))) return 0;
+            pr->is_face_index = pr->is_list && !pr->item_is_real && strcmp(e->name, "face") == 0 &&
+                                (strcmp(name, "vertex_indices") == 0 || strcmp(name, "vertex_index") == 0);
+        }
+        /* comment, obj_info and unknown lines: assimp skips them too */
+    }
+    snprintf(err, errlen, "'%s': the PLY header has no end_header line", path);
+    return -1;
+}
+
+/* Record `rec` of element e, the ASCII line at p; 0, or -1 with a message. */
+static int ply_check_record(const char *path, long lineno, const ply_element *e, unsigned long long rec,
+                            unsigned long long nvert, char *p, char *err, size_t errlen) {
+    for (int i = 0; i < e->nprops; i++) {
+        const ply_prop *pr = &e->props[i];
+        long long n = 1, v = 0;
+        char *t;
+        if (pr->is_list) {
+            if (!(t = next_token(&p))) goto short_record;
+            if (!token_is_int(t, &n) || n < 0) {
+                snprintf(err, errlen, "'%s' line %ld: %s %llu: list count '%.32s' is not a non-negative integer", path,
+                         lineno, e->name, rec, t);
+                return -1;
+            }
+        }
+        for (long long j = 0; j < n; j++) {
+            if (!(t = next_token(&p))) {
+                if (!pr->is_list) goto short_record;
+                snprintf(err, errlen, "'%s' line %ld: %s %llu: list declares %lld values but has %lld", path, lineno,
+                         e->name, rec, n, j);
+                return -1;
+            }
+            if (pr->item_is_real ? !token_is_real(t) : !token_is_int(t, &v)) {
+                snprintf(err, errlen, "'%s' line %ld: %s %llu: '%.32s' is not %s", path, lineno, e->name, rec, t,
+                         pr->item_is_real ? "a number" : "an integer");
+                return -1;
+            }
+            if (pr->is_face_index && (v < 0 || (unsigned long long)v >= nvert)) {
+                snprintf(err, errlen, "'%s' line %ld: face %llu: vertex index %lld out of range (%llu vertices)",
+                         path, lineno, rec, v, nvert);
+                return -1;
+            }
+        }
+    }
+    if (next_token(&p)) {
+        snprintf(err, errlen, "'%s' line %ld: %s %llu: more values than the header's %d properties", path, lineno,
+                 e->name, rec, e->nprops);
+        return -1;
+    }
+    return 0;
+short_record:
+    snprintf(err, errlen, "'%s' line %ld: %s %llu: fewer values than the header's %d properties", path, lineno,
+             e->name, rec, e->nprops);
+    return -1;
+}
+
+/* 0, or -1 with a message.  PLY is told by its magic line, as assimp does
+ * for a file whose extension it does not know. */
+static int ply_check(const char *path, long long file_size, char *err, size_t errlen) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0; /* the importer reports it */
+    char magic[4] = {0};
+    if (fread(magic, 1, 4, f) != 4 || strncasecmp(magic, "ply", 3) != 0 || (magic[3] != '\n' && magic[3] != '\r')) {
+        fclose(f);
+        return 0;
+    }
+    rewind(f);
+    line_reader r = {f, NULL, 0, 0, 0};
+    ply_header *h = malloc(sizeof *h);
+    int rc = 0;
+    if (!h) goto done;
+    int parsed = ply_parse_header(path, &r, h, err, errlen);
+    if (parsed <= 0) {
+        rc = parsed;
+        goto done;
+    }
+    unsigned long long nvert = ~0ull; /* no vertex element: nothing to check indices against */
+    for (int i = 0; i < h->nelem; i++)
+        if (strcmp(h->elem[i].name, "vertex") == 0) nvert = h->elem[i].count;
+    if (h->binary) {
+        /* Each record needs its fixed-size properties, each list its count
+         * and a face at least 3 indices. */
+        unsigned long long need = 0;
+        for (int i = 0; i < h->nelem; i++) {
+            const ply_element *e = &h->elem[i];
+            unsigned long long rec = 0;
+            for (int j = 0; j < e->nprops; j++) {
+                const ply_prop *pr = &e->props[j];
+                rec += pr->is_list ? (unsigned long long)pr->count_size + (pr->is_face_index ? 3u * pr->item_size : 0)
+                                   : (unsigned long long)pr->item_size;
+            }
+            need += e->count * rec; /* < 2^32 * 64 * 28 per element: no overflow */
+        }
+        unsigned long long have = (unsigned long long)(file_size - h->body);
+        if (need > have) {
+            snprintf(err, errlen,
+                     "'%s': binary PLY too short: its header declares records needing at least %llu bytes, the file "
+                     "has %llu after the header",
+                     path, need, have);
+            rc = -1;
+        }
+        goto done;
+    }
+    /* ASCII: one record per line.  assimp skips one empty line after a line
+     * ending in a bare "\n"; any other empty or blank line before the last
+     * record it reads as a record (of zeros). */
+    int ei = 0, skip_empty = r.lf_only;
+    unsigned long long in_elem = 0;
+    char *line;
+    while ((line = raw_line(&r))) {
+        int empty = line[strspn(line, "\r\n")] == 0, blank = line[strspn(line, " \t\r\n")] == 0;
+        if (empty && skip_empty) {
+            skip_empty = 0;
+            continue;
+        }
+        skip_empty = r.lf_only;
+        while (ei < h->nelem && in_elem == h->elem[ei].count) ei++, in_elem = 0;
+        if (ei == h->nelem) {
+            if (blank) continue; /* after the last record: ignored */
+            snprintf(err, errlen, "'%s' line %ld: more records than the header declares", path, r.lineno);
+            rc = -1;
+            goto done;
+        }
+        if (blank) {
+            snprintf(err, errlen, "'%s' line %ld: blank line where %s %llu is expected (read as a record)", path,
+                     r.lineno, h->elem[ei].name, in_elem);
+            rc = -1;
+            goto done;
+        }
+        if (ply_check_record(path, r.lineno, &h->elem[ei], in_elem, nvert, line, err, errlen)) {
+            rc = -1;
+            goto done;
+        }
+        in_elem++;
+    }
+    while (ei < h->nelem && in_elem == h->elem[ei].count) ei++, in_elem = 0;
+    if (ei < h->nelem) {
+        snprintf(err, errlen, "'%s': the header declares %llu %s records, the file has %llu", path,
+                 h->elem[ei].count, h->elem[ei].name, in_elem);
+        rc = -1;
+    }
+done:
+    free(h);
+    free(r.buf);
+    fclose(f);
+    return rc;
+}
+
+/* assimp's glTF importers drop faces with out-of-range indices, and the
+ * indices left over when a triangle list is not a multiple of 3, with only a
+ * log warning ("... were dropped."), as its PLY reader does for a record it
+ * cannot parse (it reads zeros); a warning like those fails the import. */
+typedef struct {
+    char msg[200];
+} dropped_note;
+
+static void note_dropped(const char *message, char *user) {
+    dropped_note *d = (dropped_note *)user;
+    if (d->msg[0] || strncmp(message, "Warn", 4) != 0 ||
+        !(strstr(message, " were dropped") || strstr(message, "Unable to parse property instance")))
+        return;
+    const char *text = strstr(message, ": "); /* after "Warn,  T0" */
+    snprintf(d->msg, sizeof d->msg, "%s", text ? text + 2 : message);
+    for (char *c = d->msg; *c; c++)
+        if (*c == '\n' || *c == '\r') *c = 0;
+}
+
 int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errlen) {
     memset(out, 0, sizeof *out);
+    /* Regular files only: a directory would reach assimp (which then reports
+     * "no meshes"), a device reads forever and opening a FIFO blocks. */
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        snprintf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+        return -1;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        snprintf(err, errlen, "'%s' is a directory, not a mesh file", path);
+        return -1;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "'%s' is not a regular file (a device, FIFO or socket), not a mesh file", path);
+        return -1;
+    }
     FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
         return -1;
     }
-    fseek(f, 0, SEEK_END);
-    long size = ftell(f);
     fclose(f);
-    if (size <= 0) {
+    if (st.st_size <= 0) {
         snprintf(err, errlen, "'%s' is empty", path);
         return -1;
     }
-    if (off_check_indices(path, err, errlen)) return -1;
+    if (off_check(path, err, errlen) || ply_check(path, (long long)st.st_size, err, errlen)) return -1;
+    dropped_note dropped = {{0}};
+    struct aiLogStream log = {note_dropped, (char *)&dropped};
+    aiAttachLogStream(&log);
     const struct aiScene *sc =
         aiImportFile(path, aiProcess_Triangulate | aiProcess_ValidateDataStructure);
+    aiDetachLogStream(&log);
     if (!sc) {
         char msg[200];
         snprintf(msg, sizeof msg, "%s", aiGetErrorString());
         for (char *c = msg; *c; c++)
             if (*c == '\n' || *c == '\r') *c = ' ';
         snprintf(err, errlen, "cannot import '%s': %s", path, msg[0] ? msg : "unknown assimp error");
+        return -1;
+    }
+    if (dropped.msg[0]) {
+        snprintf(err, errlen, "cannot import '%s': %s", path, dropped.msg);
+        aiReleaseImport(sc);
         return -1;
     }
     const char *base = strrchr(path, '/');

@@ -72,21 +72,29 @@ static size_t sphere(cbvh_tri *t, unsigned seg, const float c[3], float r) {
     return k;
 }
 
+/* A size outside a scene's range is an error, never clamped: the spec then
+ * always says what was built.  size 0 = the scene's default. */
+static int size_ok(const char *name, unsigned size, unsigned lo, unsigned hi, const char *unit, char *err,
+                   size_t errlen) {
+    if (size == 0 || (size >= lo && size <= hi)) return 1;
+    snprintf(err, errlen, "procedural scene '%s': size %u out of range %u..%u (%s)", name, size, lo, hi, unit);
+    return 0;
+}
+
 int cbvh_scene_procedural(const char *name, unsigned size, cbvh_scene *out, char *err, size_t errlen) {
     memset(out, 0, sizeof *out);
     snprintf(out->name, sizeof out->name, "proc:%s", name);
     if (strcmp(name, "cloth") == 0 || strcmp(name, "wave") == 0) {
         int cloth = name[0] == 'c';
+        if (!size_ok(name, size, 1, 20000, "grid cells per side", err, errlen)) return -1;
         unsigned n = size ? size : cloth ? 256 : 64;
-        if (n > 20000) n = 20000;
         if (alloc_tris(out, 2ull * n * n, err, errlen)) return -1;
         grid(out->tris, n, cloth ? cloth_height : wave_height);
         return 0;
     }
     if (strcmp(name, "far") == 0) {
+        if (!size_ok(name, size, 4, 4096, "sphere segments", err, errlen)) return -1;
         unsigned seg = size ? size : 48;
-        if (seg < 4) seg = 4;
-        if (seg > 4096) seg = 4096;
         if (alloc_tris(out, (uint64_t)seg * (seg / 2) * 2, err, errlen)) return -1;
         const float c[3] = {1000.3f, -2000.7f, 3000.1f};
         sphere(out->tris, seg, c, 0.01f);
@@ -96,8 +104,8 @@ int cbvh_scene_procedural(const char *name, unsigned size, cbvh_scene *out, char
         /* size x size sphere instances of 80 x 40 x 2 = 6400 triangles;
          * 40 x 40 -> 10,240,000 triangles.  Radii and positions vary so the
          * instances are not all identical. */
+        if (!size_ok(name, size, 1, 200, "instances per side", err, errlen)) return -1;
         unsigned n = size ? size : 40;
-        if (n > 200) n = 200;
         const unsigned seg = 80;
         size_t per = (size_t)seg * (seg / 2) * 2;
         if (alloc_tris(out, (uint64_t)n * n * per, err, errlen)) return -1;

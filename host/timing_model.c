@@ -11,7 +11,9 @@ void cbvh_timing_defaults(cbvh_timing_params *p) {
     p->clock_mhz = 1000.0;         /* seed 003 Sec. 6: "operating frequency is set at 1GHz" */
 }
 
-static int bad(double x, int positive) { return !isfinite(x) || x < 0 || (positive && x == 0); }
+static int bad(double x, int rate) {
+    return !isfinite(x) || x < (rate ? CBVH_TIMING_RATE_MIN : 0) || x > CBVH_TIMING_MAX;
+}
 
 int cbvh_timing_eval(const cbvh_timing_params *p, const cbvh_timing_work *w, cbvh_timing_result *o) {
     if (bad(p->box_cycles, 0) || bad(p->tri_cycles, 0) || bad(p->fetch_latency, 0) ||

@@ -15,6 +15,12 @@ typedef struct {
     double clock_mhz;            /* accelerator clock */
 } cbvh_timing_params;
 
+/* Ranges: every parameter <= CBVH_TIMING_MAX; cycles and latency >= 0;
+ * bandwidth and clock >= CBVH_TIMING_RATE_MIN (a rate near 0 would make the
+ * modelled time overflow to infinity). */
+#define CBVH_TIMING_MAX 1e9
+#define CBVH_TIMING_RATE_MIN 1e-3
+
 /* Defaults (sources in docs/timing_model.md): 1, 1, 100, 12.8, 1000. */
 void cbvh_timing_defaults(cbvh_timing_params *p);
 
@@ -31,7 +37,7 @@ typedef struct {
     double seconds;        /* cycles / (clock_mhz * 1e6) */
 } cbvh_timing_result;
 
-/* 0, or -1 if a parameter is out of range (negative, bandwidth or clock <= 0). */
+/* 0, or -1 if a parameter is out of the ranges above. */
 int cbvh_timing_eval(const cbvh_timing_params *p, const cbvh_timing_work *w, cbvh_timing_result *out);
 
 #endif

@@ -18,13 +18,13 @@ typedef struct {
     hid_device *dev;
     wchar_t serial[64];
     int use_serial;
+    uint16_t vid, pid; /* from the environment, checked once at open */
 } hid_state;
 
 static const char *udev_hint = "install firmware/udev/60-cbvh.rules into /etc/udev/rules.d and replug";
 
 static int hid_attach(hid_state *s, char *err, size_t errlen, int *none) {
-    uint16_t vid, pid;
-    cbvh_usb_identity(&vid, &pid);
+    uint16_t vid = s->vid, pid = s->pid;
     struct hid_device_info *devs = hid_enumerate(vid, pid);
     *none = devs == NULL;
     hid_free_enumeration(devs);
@@ -83,6 +83,10 @@ static int hidt_reopen(void *ctx, char *err, size_t errlen) {
 }
 
 static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t errlen) {
+    uint16_t vid, pid;
+    /* Bad settings fail the open before any device is looked for. */
+    if (cbvh_usb_identity(&vid, &pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen))
+        return CBVH_BACKEND_ERROR;
     if (hid_init() != 0) {
         snprintf(err, errlen, "hid_init failed");
         return CBVH_BACKEND_NONE;
@@ -90,8 +94,11 @@ static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t er
     hid_state *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
+        hid_exit();
         return CBVH_BACKEND_ERROR;
     }
+    s->vid = vid;
+    s->pid = pid;
     if (arg && *arg) {
         mbstowcs(s->serial, arg, sizeof s->serial / sizeof s->serial[0] - 1);
         s->use_serial = 1;
@@ -104,7 +111,7 @@ static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t er
     }
     cbvh_link_io io = {s, hidt_write, hidt_read, hidt_reopen};
     cbvh_link_init(&s->link, &io);
-    cbvh_link_env_options(&s->link);
+    cbvh_link_env_options(&s->link, err, errlen); /* checked above */
     cbvh_link_flush(&s->link, 20);
     char why[200];
     if (cbvh_link_identify(&s->link, why, sizeof why)) {
@@ -114,8 +121,6 @@ static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t er
         hid_exit();
         return CBVH_BACKEND_ERROR;
     }
-    uint16_t vid, pid;
-    cbvh_usb_identity(&vid, &pid);
     const cbvh_identity *id = &s->link.ident;
     snprintf(b->label, sizeof b->label, "hid %04x:%04x %s (fw %u.%u.%u, datapath v%u)", vid, pid, id->board_name,
              id->fw_major, id->fw_minor, id->fw_patch, (unsigned)id->datapath_version);
@@ -146,7 +151,11 @@ const cbvh_backend_ops cbvh_backend_hid = {"hid", hid_open_board, hid_close_boar
 
 int cbvh_hid_describe(FILE *out) {
     uint16_t vid, pid;
-    cbvh_usb_identity(&vid, &pid);
+    char why[200];
+    if (cbvh_usb_identity(&vid, &pid, why, sizeof why)) {
+        fprintf(out, "hid:   not probed (%s)\n", why);
+        return 0;
+    }
     if (hid_init() != 0) {
         fprintf(out, "hid:   none (hid_init failed)\n");
         return 0;

@@ -58,6 +58,10 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         snprintf(err, errlen, "sim backend needs an address: sim:unix:PATH or sim:tcp:HOST:PORT");
         return CBVH_BACKEND_ERROR;
     }
+    /* A wrong address or setting is reported as such, not as "no board
+     * (start one with ...)" with a hint that would fail the same way. */
+    if (cbvh_sim_addr_check(arg, err, errlen) || cbvh_link_env_options(NULL, err, errlen))
+        return CBVH_BACKEND_ERROR;
     sim_state *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
@@ -77,13 +81,16 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
     char why[200];
     s->fd = cbvh_sim_connect(s->addr, why, sizeof why);
     if (s->fd < 0) {
-        snprintf(err, errlen, "no virtual board: %s (start one with `cbvh board-sim --listen %s`)", why, s->addr);
+        if (s->fd == CBVH_SIM_BAD_ADDR) /* e.g. a host name that does not resolve */
+            snprintf(err, errlen, "bad board address: %s", why);
+        else
+            snprintf(err, errlen, "no virtual board: %s (start one with `cbvh board-sim --listen %s`)", why, s->addr);
         free(s);
         return CBVH_BACKEND_ERROR;
     }
     cbvh_link_io io = {s, sock_write, sock_read, sock_reopen};
     cbvh_link_init(&s->link, &io);
-    cbvh_link_env_options(&s->link);
+    cbvh_link_env_options(&s->link, err, errlen); /* checked above */
     cbvh_link_flush(&s->link, 5);
     if (cbvh_link_identify(&s->link, why, sizeof why)) {
         snprintf(err, errlen, "virtual board at %s: %s", s->addr, why);

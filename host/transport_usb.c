@@ -15,6 +15,7 @@ typedef struct {
     libusb_context *ctx;
     libusb_device_handle *h;
     uint8_t ep_in, ep_out;
+    uint16_t vid, pid; /* from the environment, checked once at open */
     char serial[64];
 } usb_state;
 
@@ -22,8 +23,7 @@ static const char *udev_hint = "install firmware/udev/60-cbvh.rules into /etc/ud
 
 /* Finds the board (optionally by serial) and opens and claims it. */
 static int usb_attach(usb_state *s, char *err, size_t errlen, int *none) {
-    uint16_t vid, pid;
-    cbvh_usb_identity(&vid, &pid);
+    uint16_t vid = s->vid, pid = s->pid;
     libusb_device **list = NULL;
     ssize_t n = libusb_get_device_list(s->ctx, &list);
     int rc = -1, seen = 0;
@@ -130,6 +130,11 @@ static int usb_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         return CBVH_BACKEND_ERROR;
     }
     if (arg) snprintf(s->serial, sizeof s->serial, "%s", arg);
+    /* Bad settings fail the open before any device is looked for. */
+    if (cbvh_usb_identity(&s->vid, &s->pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen)) {
+        free(s);
+        return CBVH_BACKEND_ERROR;
+    }
     int rc = libusb_init(&s->ctx);
     if (rc != 0) {
         snprintf(err, errlen, "libusb_init failed: %s", libusb_strerror(rc));
@@ -144,7 +149,7 @@ static int usb_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
     }
     cbvh_link_io io = {s, usb_write, usb_read, usb_reopen};
     cbvh_link_init(&s->link, &io);
-    cbvh_link_env_options(&s->link);
+    cbvh_link_env_options(&s->link, err, errlen); /* checked above */
     cbvh_link_flush(&s->link, 20); /* stale IN packets from an earlier session */
     char why[200];
     if (cbvh_link_identify(&s->link, why, sizeof why)) {
@@ -154,10 +159,8 @@ static int usb_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         free(s);
         return CBVH_BACKEND_ERROR;
     }
-    uint16_t vid, pid;
-    cbvh_usb_identity(&vid, &pid);
     const cbvh_identity *id = &s->link.ident;
-    snprintf(b->label, sizeof b->label, "usb %04x:%04x %s (fw %u.%u.%u, datapath v%u)", vid, pid, id->board_name,
+    snprintf(b->label, sizeof b->label, "usb %04x:%04x %s (fw %u.%u.%u, datapath v%u)", s->vid, s->pid, id->board_name,
              id->fw_major, id->fw_minor, id->fw_patch, (unsigned)id->datapath_version);
     b->state = s;
     return CBVH_BACKEND_OK;
@@ -186,7 +189,11 @@ const cbvh_backend_ops cbvh_backend_usb = {"usb", usb_open, usb_close, usb_run};
 
 int cbvh_usb_describe(FILE *out) {
     uint16_t vid, pid;
-    cbvh_usb_identity(&vid, &pid);
+    char why[200];
+    if (cbvh_usb_identity(&vid, &pid, why, sizeof why)) {
+        fprintf(out, "usb:   not probed (%s)\n", why);
+        return 0;
+    }
     libusb_context *ctx = NULL;
     int rc = libusb_init(&ctx);
     if (rc != 0) {

@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static const char *const status_names[] = {
     "ok",          "cannot read file", "empty file",         "not a vector file", "bad header",
@@ -406,6 +407,26 @@ int cbvh_read_file(const char *path, char **buf, size_t *len, char *err, size_t 
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
+    /* Only regular files of bounded size: /dev/zero, a FIFO or a huge file
+     * would otherwise be read until memory runs out (a directory fails here
+     * too, with a clearer message than a read error). */
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0) {
+        snprintf(err, errlen, "%s: cannot stat: %s", path, strerror(errno));
+        fclose(f);
+        return -1;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "%s: not a regular file%s", path, S_ISDIR(st.st_mode) ? " (a directory)" : "");
+        fclose(f);
+        return -1;
+    }
+    if ((uint64_t)st.st_size > CBVH_READ_MAX_BYTES) {
+        snprintf(err, errlen, "%s: %lld bytes, larger than the %llu this tool reads", path, (long long)st.st_size,
+                 (unsigned long long)CBVH_READ_MAX_BYTES);
+        fclose(f);
+        return -1;
+    }
     size_t cap = 1 << 16, n = 0;
     char *b = malloc(cap);
     int oom = !b;
@@ -422,6 +443,10 @@ int cbvh_read_file(const char *path, char **buf, size_t *len, char *err, size_t 
         size_t got = fread(b + n, 1, cap - n, f);
         n += got;
         if (got == 0) break;
+        if (n > CBVH_READ_MAX_BYTES) { /* the file grew while being read */
+            oom = 1;
+            break;
+        }
     }
     int bad = oom || ferror(f);
     fclose(f);

@@ -18,6 +18,7 @@
 #define CBVH_VEC_MAGIC "# cbvh golden vectors"
 #define CBVH_VEC_FORMAT 1
 #define CBVH_VEC_MAX_COUNT 100000000u /* sanity bound on the count header */
+#define CBVH_READ_MAX_BYTES (UINT64_C(1) << 31) /* vector files and manifests: 2 GiB at most */
 
 /* Reader results.  Each names one class of bad input; the message says more. */
 typedef enum {

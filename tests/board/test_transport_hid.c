@@ -5,7 +5,8 @@
  * in-process firmware core whose FPGA is the model.  Checks: report format on
  * the wire, `--backend hid` results equal the model for every unit,
  * `--backend auto` picks hid when there is no usb board, malformed reports
- * are survived. */
+ * are survived, a bad CBVH_USB_VID/PID fails the open (and the listing)
+ * with one line instead of looking for another device. */
 #include <hidapi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +15,7 @@
 #include "board_link.h"
 #include "cbvh_sim.h"
 #include "gen_inputs.h"
+#include "test_util.h"
 
 #define REPORTS 4096
 static struct {
@@ -22,7 +24,7 @@ static struct {
     cbvh_fw fw;
     uint8_t q[REPORTS][64];
     size_t head, tail;
-    unsigned long writes, bad_writes, reports_in;
+    unsigned long writes, bad_writes, reports_in, enumerates;
     int inject_bad_report;
 } dev;
 static struct hid_device_info info;
@@ -43,6 +45,7 @@ static const cbvh_fw_hal hal = {&dev.regs, cbvh_regmap_model_read, cbvh_regmap_m
 int hid_init(void) { return 0; }
 int hid_exit(void) { return 0; }
 struct hid_device_info *hid_enumerate(unsigned short vid, unsigned short pid) {
+    dev.enumerates++;
     if (!dev.present || vid != CBVH_USB_VID_DEFAULT || pid != CBVH_USB_PID_DEFAULT) return NULL;
     memset(&info, 0, sizeof info);
     info.vendor_id = vid;
@@ -91,14 +94,7 @@ int hid_read_timeout(hid_device *d, unsigned char *data, size_t length, int ms) 
 }
 
 static int fails;
-#define CHECK(c, ...)                                                                                                  \
-    do {                                                                                                               \
-        if (!(c)) {                                                                                                    \
-            fprintf(stderr, "FAIL: " __VA_ARGS__);                                                                     \
-            fprintf(stderr, "\n");                                                                                     \
-            fails++;                                                                                                   \
-        }                                                                                                              \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(fails, stderr, c, __VA_ARGS__)
 
 int main(void) {
     char err[512];
@@ -109,6 +105,27 @@ int main(void) {
     CHECK(cbvh_backend_open("hid", &b, NULL, err, sizeof err) != 0 && strstr(err, "no HID device"), "absent: '%s'", err);
 
     dev.present = 1;
+    /* Bad identity settings: one line naming the variable, no enumeration
+     * (strtoul took "zzzz" as 0000, "123456" as 3456, "-1" as ffff). */
+    static const char *const bad[][2] = {{"CBVH_USB_VID", "zzzz"}, {"CBVH_USB_VID", "123456"}, {"CBVH_USB_PID", "-1"},
+                                         {"CBVH_USB_PID", "0xc0b1 "}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char want[128];
+        snprintf(want, sizeof want, "%s='%s' is not a USB ID (expected 1 to 4 hex digits", bad[i][0], bad[i][1]);
+        setenv(bad[i][0], bad[i][1], 1);
+        unsigned long en = dev.enumerates;
+        int rc = cbvh_backend_open("hid", &b, NULL, err, sizeof err);
+        CHECK(rc != 0 && strstr(err, want) && !strchr(err, '\n') && dev.enumerates == en && !dev.opened,
+              "%s=%s: open gave %d, '%s'", bad[i][0], bad[i][1], rc, err);
+        FILE *f = tmpfile();
+        CHECK(cbvh_hid_describe(f) == 0 && dev.enumerates == en, "%s=%s: listing probed anyway", bad[i][0], bad[i][1]);
+        char line[300] = "";
+        rewind(f);
+        CHECK(fgets(line, sizeof line, f) && strncmp(line, "hid:   not probed (", 19) == 0 && strstr(line, want),
+              "%s=%s: listing said '%s'", bad[i][0], bad[i][1], line);
+        fclose(f);
+        unsetenv(bad[i][0]);
+    }
     cbvh_regmap_model_init(&dev.regs);
     cbvh_fw_init(&dev.fw, &hal);
     if (cbvh_backend_open("hid", &b, NULL, err, sizeof err)) {

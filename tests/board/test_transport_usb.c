@@ -4,7 +4,10 @@
  * bulk OUT 0x01 / IN 0x81 wired to an in-process firmware core (model FPGA).
  * Checks: results equal the model for every unit, a device that vanishes in
  * the middle of a batch is reopened and the batch completes, "permission
- * denied" names the udev rule, no device is reported as none. */
+ * denied" names the udev rule, no device is reported as none, bad
+ * CBVH_USB_VID/PID or CBVH_LINK_* settings fail the open before any device is
+ * touched, and a board reporting a small max payload in IDENTIFY only gets
+ * frames that fit it. */
 #include <libusb.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,9 +16,12 @@
 #include "board_link.h"
 #include "cbvh_sim.h"
 #include "gen_inputs.h"
+#include "test_util.h"
 
 static struct {
     int present, deny, opened, claimed, vanish_after; /* vanish_after: OUT transfers until a NO_DEVICE */
+    uint16_t max_payload; /* non-zero: what the board's IDENTIFY reply claims instead of 4096 */
+    size_t max_out;       /* largest OUT transfer seen */
     cbvh_regmap_model regs;
     cbvh_fw fw;
     uint8_t in[1 << 16];
@@ -27,6 +33,14 @@ static libusb_device *list[2];
 
 static void fw_send(void *ctx, const uint8_t *frame, size_t len) {
     (void)ctx;
+    static uint8_t patched[CBVH_FRAME_MAX];
+    if (dev.max_payload && frame[2] == (CBVH_CMD_IDENTIFY | CBVH_REPLY) && len <= sizeof patched) {
+        /* a board with smaller frames: same identity, max payload field (offset 12) changed, CRC redone */
+        memcpy(patched, frame, len);
+        cbvh_put16(patched + CBVH_FRAME_HDR + 12, dev.max_payload);
+        len = cbvh_frame_seal(patched, frame[2], frame[3], cbvh_get16(frame + 4), cbvh_get16(frame + 6));
+        frame = patched;
+    }
     for (size_t i = 0; i < len; i++) dev.in[dev.head++ % sizeof dev.in] = frame[i];
 }
 static const cbvh_fw_hal hal = {&dev.regs, cbvh_regmap_model_read, cbvh_regmap_model_write, fw_send, "usb-fake"};
@@ -125,6 +139,7 @@ int LIBUSB_CALL libusb_bulk_transfer(libusb_device_handle *h, unsigned char ep, 
             return LIBUSB_ERROR_NO_DEVICE;
         }
         dev.outs++;
+        if ((size_t)length > dev.max_out) dev.max_out = (size_t)length;
         cbvh_fw_rx(&dev.fw, data, (size_t)length);
         *transferred = length;
         return 0;
@@ -142,14 +157,7 @@ const char *LIBUSB_CALL libusb_strerror(int code) {
 }
 
 static int fails;
-#define CHECK(c, ...)                                                                                                  \
-    do {                                                                                                               \
-        if (!(c)) {                                                                                                    \
-            fprintf(stderr, "FAIL: " __VA_ARGS__);                                                                     \
-            fprintf(stderr, "\n");                                                                                     \
-            fails++;                                                                                                   \
-        }                                                                                                              \
-    } while (0)
+#define CHECK(c, ...) TU_CHECK(fails, stderr, c, __VA_ARGS__)
 
 int main(void) {
     char err[512];
@@ -163,6 +171,36 @@ int main(void) {
     CHECK(cbvh_backend_open("usb", &b, NULL, err, sizeof err) != 0 && strstr(err, "60-cbvh.rules"),
           "no permission must point at the udev rule: '%s'", err);
     dev.deny = 0;
+    /* Bad settings: one line naming the variable and the accepted form, and
+     * the (present) device is not even opened under a wrong identity. */
+    static const struct {
+        const char *var, *val, *want;
+    } bad[] = {
+        {"CBVH_USB_VID", "zzzz", "CBVH_USB_VID='zzzz' is not a USB ID (expected 1 to 4 hex digits, optional 0x"},
+        {"CBVH_USB_VID", "123456", "CBVH_USB_VID='123456' is not a USB ID"},
+        {"CBVH_USB_PID", "-1", "CBVH_USB_PID='-1' is not a USB ID"},
+        {"CBVH_USB_PID", "0x", "CBVH_USB_PID='0x' is not a USB ID"},
+        {"CBVH_LINK_TIMEOUT_MS", "5x", "CBVH_LINK_TIMEOUT_MS='5x' is not valid (expected an integer in 1..600000)"},
+        {"CBVH_LINK_TIMEOUT_MS", "0", "CBVH_LINK_TIMEOUT_MS='0' is not valid"},
+        {"CBVH_LINK_RETRIES", "99999999999", "CBVH_LINK_RETRIES='99999999999' is not valid (expected an integer in 0..1000)"},
+        {"CBVH_LINK_RETRIES", "-1", "CBVH_LINK_RETRIES='-1' is not valid"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        setenv(bad[i].var, bad[i].val, 1);
+        unsigned long opens = dev.opens;
+        int rc = cbvh_backend_open("usb", &b, NULL, err, sizeof err);
+        CHECK(rc != 0 && strstr(err, bad[i].want) && !strchr(err, '\n') && dev.opens == opens,
+              "%s=%s: open gave %d, '%s'", bad[i].var, bad[i].val, rc, err);
+        /* auto must not fall back to the model over it either */
+        rc = cbvh_backend_open("auto", &b, NULL, err, sizeof err);
+        CHECK(rc != 0 && strstr(err, bad[i].want), "auto with %s=%s: %d, '%s'", bad[i].var, bad[i].val, rc, err);
+        if (rc == 0) cbvh_backend_close(&b);
+        unsetenv(bad[i].var);
+    }
+    /* The accepted forms: 0x prefix, either case; empty means unset. */
+    setenv("CBVH_USB_VID", "0x1209", 1);
+    setenv("CBVH_USB_PID", "C0B1", 1);
+    setenv("CBVH_LINK_RETRIES", "", 1);
     cbvh_regmap_model_init(&dev.regs);
     cbvh_fw_init(&dev.fw, &hal);
     if (cbvh_backend_open("usb", &b, NULL, err, sizeof err)) {
@@ -170,6 +208,10 @@ int main(void) {
         return 1;
     }
     printf("opened: %s\n", b.label);
+    CHECK(cbvh_backend_link(&b)->max_retries == CBVH_LINK_RETRIES_DEFAULT, "empty CBVH_LINK_RETRIES is not the default");
+    unsetenv("CBVH_USB_VID");
+    unsetenv("CBVH_USB_PID");
+    unsetenv("CBVH_LINK_RETRIES");
     if (cbvh_backend_open("model", &model, NULL, err, sizeof err)) return 1;
     uint64_t rng = 11;
     size_t total = 0;
@@ -207,6 +249,54 @@ int main(void) {
     char buf[256] = "";
     CHECK(fgets(buf, sizeof buf, f) && strstr(buf, "\"cbvh board\" serial FAKE0001"), "describe: '%s'", buf);
     fclose(f);
+
+    /* A board that takes 64-byte payloads (IDENTIFY) gets no larger frame:
+     * batches are cut to fit, results unchanged; a unit whose single vector
+     * does not fit is refused by name, not sent. */
+    dev.max_payload = 64;
+    if (cbvh_backend_open("usb", &b, NULL, err, sizeof err)) {
+        fprintf(stderr, "FAIL: open usb (64-byte board): %s\n", err);
+        return 1;
+    }
+    l = cbvh_backend_link(&b);
+    CHECK(l->ident.max_payload == 64, "IDENTIFY max payload read as %u", l->ident.max_payload);
+    const cbvh_unit *ac = cbvh_unit_find("axis_compress");
+    cbvh_unit_config cfg = {{6, -30}, CBVH_ENC_MODULO};
+    cbvh_layout lay;
+    ac->layout(&cfg, &lay);
+    size_t count = 200;
+    uint32_t *in = malloc(count * (size_t)lay.n_in * 4), *a = malloc(count * (size_t)lay.n_out * 4),
+             *o = malloc(count * (size_t)lay.n_out * 4);
+    cbvh_gen_inputs(&rng, &cfg, &lay, in, count);
+    model.ops->run(&model, ac, &cfg, in, a, count, err, sizeof err);
+    dev.max_out = 0;
+    unsigned long outs = dev.outs;
+    int rc = b.ops->run(&b, ac, &cfg, in, o, count, err, sizeof err);
+    CHECK(rc == 0, "axis_compress on a 64-byte board: %s", err);
+    CHECK(rc != 0 || memcmp(a, o, count * (size_t)lay.n_out * 4) == 0, "axis_compress on a 64-byte board differs");
+    CHECK(dev.max_out <= CBVH_FRAME_HDR + 64 + CBVH_FRAME_CRC, "a %zu-byte frame was sent to a 64-byte board",
+          dev.max_out);
+    printf("64-byte board: %zu axis_compress vectors in %lu frames of at most %zu bytes\n", count, dev.outs - outs,
+           dev.max_out);
+    free(in), free(a), free(o);
+    const cbvh_unit *big = NULL; /* a unit whose one vector needs more than 64 bytes */
+    for (int u = 0; u < cbvh_unit_count && !big; u++) {
+        cbvh_units[u]->layout(&cfg, &lay);
+        if (12 + 4 * lay.n_in > 64 || 4 + 4 * lay.n_out > 64) big = cbvh_units[u];
+    }
+    if (big) {
+        big->layout(&cfg, &lay);
+        uint32_t one_in[64] = {0}, one_out[64];
+        outs = dev.outs;
+        rc = b.ops->run(&b, big, &cfg, one_in, one_out, 1, err, sizeof err);
+        CHECK(rc != 0 && strstr(err, big->name) && strstr(err, "does not fit the board's 64-byte frames") &&
+                  dev.outs == outs,
+              "%s on a 64-byte board: rc %d, '%s', %lu frames sent", big->name, rc, err, dev.outs - outs);
+    } else {
+        CHECK(0, "no unit needs more than a 64-byte frame at N=6; pick another case");
+    }
+    cbvh_backend_close(&b);
+    dev.max_payload = 0;
     cbvh_backend_close(&model);
     return fails ? 1 : 0;
 }

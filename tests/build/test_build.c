@@ -1,4 +1,5 @@
 /* Scenes, float builders and CBVH compressors (issue 3). */
+#define _POSIX_C_SOURCE 200809L /* mkfifo */
 #include <float.h>
 #include <math.h>
 #include <setjmp.h>
@@ -8,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -190,6 +192,248 @@ static void test_import_errors(void **st) {
     assert_non_null(strstr(errbuf, "cannot open"));
     assert_int_equal(cbvh_scene_open("proc:nosuch", &s, errbuf, sizeof errbuf), -1);
     assert_int_equal(cbvh_scene_open("proc:cloth:0", &s, errbuf, sizeof errbuf), -1);
+}
+
+/* The import of `path` fails with a one-line message starting with `want`
+ * (printf format, %s = path) and leaves nothing loaded. */
+static void expect_error_at(const char *path, const char *want_fmt) {
+    char want[512];
+    snprintf(want, sizeof want, want_fmt, path);
+    cbvh_scene s;
+    errbuf[0] = 0;
+    assert_int_equal(cbvh_scene_import(path, &s, errbuf, sizeof errbuf), -1);
+    assert_null(s.tris);
+    assert_int_equal(s.ntris, 0);
+    assert_null(strchr(errbuf, '\n'));
+    if (strncmp(errbuf, want, strlen(want)) != 0) fail_msg("error '%s' does not start with '%s'", errbuf, want);
+}
+
+static void expect_error_prefix(const char *suffix, const void *data, size_t len, const char *want_fmt) {
+    char *p = write_temp(suffix, data, len);
+    expect_error_at(p, want_fmt);
+    remove(p);
+}
+
+static void expect_text_error(const char *suffix, const char *text, const char *want_fmt) {
+    expect_error_prefix(suffix, text, strlen(text), want_fmt);
+}
+
+#define PLY_ASCII_HEAD(nv, nf)                                                                                  \
+    "ply\nformat ascii 1.0\nelement vertex " #nv "\nproperty float x\nproperty float y\nproperty float z\n"     \
+    "element face " #nf "\nproperty list uchar int vertex_indices\nend_header\n"
+#define QUAD_VERTS "0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
+
+/* assimp trusts a PLY header's counts: the body is checked against them. */
+static void test_import_ply_counts(void **st) {
+    (void)st;
+    /* one face fewer than declared: assimp invented a third triangle */
+    expect_text_error("f.ply", PLY_ASCII_HEAD(4, 3) QUAD_VERTS "3 0 1 2\n3 0 2 3\n",
+                      "'%s': the header declares 3 face records, the file has 2");
+    /* one vertex fewer: assimp read the first face line as a vertex */
+    expect_text_error("v.ply", PLY_ASCII_HEAD(5, 2) QUAD_VERTS "3 0 1 2\n3 0 2 3\n",
+                      "'%s' line 14: vertex 4: more values than the header's 3 properties");
+    expect_text_error("x.ply", PLY_ASCII_HEAD(4, 1) QUAD_VERTS "3 0 1 2\n0 0 1\n",
+                      "'%s' line 15: more records than the header declares");
+    expect_text_error("l.ply", PLY_ASCII_HEAD(4, 2) QUAD_VERTS "3 0 1\n3 0 2 3\n",
+                      "'%s' line 14: face 0: list declares 3 values but has 2");
+    expect_text_error("n.ply", PLY_ASCII_HEAD(4, 2) "0 0 0\n1 y 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+                      "'%s' line 11: vertex 1: 'y' is not a number");
+    expect_text_error("i.ply", PLY_ASCII_HEAD(4, 2) QUAD_VERTS "3 0 1 2\n3 0 2 z\n",
+                      "'%s' line 15: face 1: 'z' is not an integer");
+    expect_text_error("r.ply", PLY_ASCII_HEAD(4, 2) QUAD_VERTS "3 0 1 2\n3 0 2 4\n",
+                      "'%s' line 15: face 1: vertex index 4 out of range (4 vertices)");
+    expect_text_error("h.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n",
+                      "'%s': the PLY header has no end_header line");
+    expect_text_error("c.ply", "ply\nformat ascii 1.0\nelement vertex -3\nproperty float x\nend_header\n",
+                      "'%s' line 3: element 'vertex' count '-3' is not an integer in 0..4294967295");
+    /* assimp reads these blank lines as records of zeros (and then dropped
+     * a face): a second empty line, an empty line after "\r\n", spaces */
+    expect_text_error("b2.ply", PLY_ASCII_HEAD(4, 2) QUAD_VERTS "\n\n3 0 1 2\n3 0 2 3\n",
+                      "'%s' line 15: blank line where face 0 is expected (read as a record)");
+    expect_text_error("bc.ply", PLY_ASCII_HEAD(4, 2) "0 0 0\r\n1 0 0\r\n1 1 0\r\n0 1 0\r\n\r\n3 0 1 2\r\n3 0 2 3\r\n",
+                      "'%s' line 14: blank line where face 0 is expected (read as a record)");
+    expect_text_error("bs.ply", PLY_ASCII_HEAD(4, 2) QUAD_VERTS "  \n3 0 1 2\n3 0 2 3\n",
+                      "'%s' line 14: blank line where face 0 is expected (read as a record)");
+    /* one empty line after a record, trailing empty lines, comments in the
+     * header and extra elements with their own records are fine */
+    cbvh_scene s;
+    no_error(import_text("ok.ply",
+                         "ply\nformat ascii 1.0\ncomment x\nelement vertex 4\nproperty float x\nproperty float y\n"
+                         "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                         "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n" QUAD_VERTS
+                         "\n3 0 1 2\n3 0 2 3\n0 1\n\n\n",
+                         &s));
+    assert_int_equal(s.ntris, 2);
+    cbvh_scene_free(&s);
+}
+
+/* A binary PLY: header + 4 vertices + the faces given (3 indices each). */
+static size_t binary_ply(uint8_t *out, const char *endian, unsigned nv_declared, unsigned nf_declared, int nfaces) {
+    int n = sprintf((char *)out,
+                    "ply\nformat binary_%s_endian 1.0\nelement vertex %u\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face %u\nproperty list uchar int vertex_indices\nend_header\n",
+                    endian, nv_declared, nf_declared);
+    int big = endian[0] == 'b';
+    const float v[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const int32_t f[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int i = 0; i < 12 + 3 * nfaces; i++) {
+        if (i >= 12 && (i - 12) % 3 == 0) out[n++] = 3;
+        uint32_t w;
+        if (i < 12)
+            memcpy(&w, &v[i], 4);
+        else
+            memcpy(&w, &f[(i - 12) / 3][(i - 12) % 3], 4);
+        for (int b = 0; b < 4; b++) out[n++] = (uint8_t)(w >> (big ? 24 - 8 * b : 8 * b));
+    }
+    return (size_t)n;
+}
+
+static void test_import_ply_binary_size(void **st) {
+    (void)st;
+    uint8_t buf[512];
+    cbvh_scene s;
+    for (int e = 0; e < 2; e++) {
+        const char *endian = e ? "big" : "little";
+        size_t n = binary_ply(buf, endian, 4, 2, 2);
+        char *p = write_temp("b.ply", buf, n);
+        no_error(cbvh_scene_import(p, &s, errbuf, sizeof errbuf));
+        remove(p);
+        assert_int_equal(s.ntris, 2);
+        assert_float_equal(s.tris[1].v[2][1], 1.0f, 0.0f);
+        cbvh_scene_free(&s);
+        /* 3 faces declared, 2 present: 48 + 3 x 13 bytes needed, 74 there */
+        n = binary_ply(buf, endian, 4, 3, 2);
+        expect_error_prefix("t.ply", buf, n,
+                            "'%s': binary PLY too short: its header declares records needing at least 87 bytes, "
+                            "the file has 74 after the header");
+    }
+    /* 4e9 vertices claimed by a tiny file: refused before assimp allocates
+     * (it threw std::bad_alloc; under ASan the process aborted) */
+    size_t n = binary_ply(buf, "little", 4000000000u, 2, 2);
+    expect_error_prefix("g.ply", buf, n,
+                        "'%s': binary PLY too short: its header declares records needing at least 48000000026 "
+                        "bytes, the file has 74 after the header");
+}
+
+static void test_import_off_tokens(void **st) {
+    (void)st;
+    const char *head = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n";
+    char text[256];
+    snprintf(text, sizeof text, "%s3 0 1 x\n3 0 2 3\n", head);
+    expect_text_error("x.off", text, "'%s' line 7: face 0: vertex index 'x' is not a number");
+    snprintf(text, sizeof text, "%sx 0 1 2\n3 0 2 3\n", head);
+    expect_text_error("k.off", text, "'%s' line 7: face 0: vertex count 'x' is not an integer");
+    snprintf(text, sizeof text, "%s0\n3 0 1 2\n3 0 2 3\n", head);
+    expect_text_error("z.off", text, "'%s' line 7: face 0 has 0 vertices (the OFF importer takes 1 to 9)");
+    snprintf(text, sizeof text, "%s3 0 1 2\n# c\n3 0 2 3\n", head);
+    expect_text_error("h.off", text, "'%s' line 8: a comment or blank line among the records (read as a record)");
+    snprintf(text, sizeof text, "%s3 0 1\n3 0 2 3\n", head);
+    expect_text_error("s.off", text, "'%s' line 7: face 0 declares 3 vertices but lists 2");
+    snprintf(text, sizeof text, "%s3 0 1 2\n3 0 2 3\n0 0 1\n", head);
+    expect_text_error("e.off", text, "'%s' line 9: more records than the header's 4 vertices and 2 faces");
+    expect_text_error("v.off", "OFF\n4 2 0\n0 0 0\n1 x 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+                      "'%s' line 4: vertex 1: coordinate 'x' is not a number");
+    expect_text_error("w.off", "OFF\n4 2 0\n0 0 0\n1 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+                      "'%s' line 4: vertex 1 has 2 coordinates, 3 needed");
+    expect_text_error("t.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                      "'%s': the header declares 3 vertices and 2 faces, the file ends after 4");
+    expect_text_error("c.off", "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                      "'%s' line 2: the OFF header needs vertex, face and edge counts");
+    /* comments in the header and after a record, empty lines and a colour
+     * after the indices are fine */
+    cbvh_scene s;
+    no_error(import_text("ok.off",
+                         "# c\nOFF\n# c\n4 2 0\n# c\n0 0 0 # c\n1 0 0\n\n1 1 0\n0 1 0\n3 0 1 2 255 0 0\n\n"
+                         "3 0 2 3 # c\n\n# c\n",
+                         &s));
+    assert_int_equal(s.ntris, 2);
+    cbvh_scene_free(&s);
+}
+
+/* glTF: one primitive over 4 vertices with the given uint16 indices. */
+static void gltf_indexed(char *out, size_t len, const uint16_t *idx, int nidx) {
+    uint8_t buf[48 + 24] = {0};
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    memcpy(buf, pos, sizeof pos);
+    memcpy(buf + 48, idx, (size_t)nidx * 2);
+    char enc[200];
+    base64(buf, 48 + (size_t)nidx * 2, enc);
+    snprintf(out, len,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+             "\"buffers\":[{\"byteLength\":%d,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+             "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":%d}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":%d,"
+             "\"type\":\"SCALAR\"}]}",
+             48 + nidx * 2, enc, nidx * 2, nidx);
+}
+
+/* assimp drops glTF faces with out-of-range indices (and a partial last
+ * triangle) with only a log warning. */
+static void test_import_gltf_dropped_faces(void **st) {
+    (void)st;
+    char gltf[2048];
+    const uint16_t good[6] = {0, 1, 2, 0, 2, 3}, bad[6] = {0, 1, 2, 0, 1, 9}, partial[5] = {0, 1, 2, 0, 2};
+    cbvh_scene s;
+    gltf_indexed(gltf, sizeof gltf, good, 6);
+    no_error(import_text("g.gltf", gltf, &s));
+    assert_int_equal(s.ntris, 2);
+    cbvh_scene_free(&s);
+    gltf_indexed(gltf, sizeof gltf, bad, 6);
+    expect_text_error("b.gltf", gltf,
+                      "cannot import '%s': Some faces had out-of-range indices. Those faces were dropped.");
+    gltf_indexed(gltf, sizeof gltf, partial, 5);
+    expect_text_error("p.gltf", gltf,
+                      "cannot import '%s': The number of vertices was not compatible with the TRIANGLES mode");
+}
+
+/* Only regular files: a directory, a device or a FIFO is named as such (a
+ * FIFO used to block in open: the alarm fails the test instead of hanging). */
+static void test_import_not_regular_file(void **st) {
+    (void)st;
+    char path[256];
+    snprintf(path, sizeof path, "/tmp/cbvh_test_%d_dir.obj", (int)getpid());
+    assert_int_equal(mkdir(path, 0700), 0);
+    expect_error_at(path, "'%s' is a directory, not a mesh file");
+    rmdir(path);
+    expect_error_at("/dev/zero", "'%s' is not a regular file (a device, FIFO or socket), not a mesh file");
+    snprintf(path, sizeof path, "/tmp/cbvh_test_%d_fifo.obj", (int)getpid());
+    assert_int_equal(mkfifo(path, 0600), 0);
+    alarm(20);
+    expect_error_at(path, "'%s' is not a regular file (a device, FIFO or socket), not a mesh file");
+    alarm(0);
+    remove(path);
+}
+
+/* Procedural sizes outside a scene's range are errors (they were clamped,
+ * so proc:far:2 gave the 16 triangles of proc:far:4). */
+static void test_proc_size_range(void **st) {
+    (void)st;
+    static const struct {
+        const char *spec, *err;
+    } bad[] = {
+        {"proc:far:2", "procedural scene 'far': size 2 out of range 4..4096 (sphere segments)"},
+        {"proc:far:4097", "procedural scene 'far': size 4097 out of range 4..4096 (sphere segments)"},
+        {"proc:cloth:20001", "procedural scene 'cloth': size 20001 out of range 1..20000 (grid cells per side)"},
+        {"proc:wave:100000", "procedural scene 'wave': size 100000 out of range 1..20000 (grid cells per side)"},
+        {"proc:instanced:201", "procedural scene 'instanced': size 201 out of range 1..200 (instances per side)"},
+    };
+    cbvh_scene s;
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        errbuf[0] = 0;
+        assert_int_equal(cbvh_scene_open(bad[i].spec, &s, errbuf, sizeof errbuf), -1);
+        assert_null(s.tris);
+        assert_int_equal(s.ntris, 0);
+        assert_string_equal(errbuf, bad[i].err);
+    }
+    no_error(cbvh_scene_open("proc:far:4", &s, errbuf, sizeof errbuf));
+    assert_int_equal(s.ntris, 16);
+    cbvh_scene_free(&s);
+    no_error(cbvh_scene_open("proc:far", &s, errbuf, sizeof errbuf));
+    assert_int_equal(s.ntris, 2304);
+    cbvh_scene_free(&s);
 }
 
 static void test_scene_validate(void **st) {
@@ -609,6 +853,12 @@ int main(void) {
         cmocka_unit_test(test_import_formats),
         cmocka_unit_test(test_import_gltf_morph),
         cmocka_unit_test(test_import_errors),
+        cmocka_unit_test(test_import_ply_counts),
+        cmocka_unit_test(test_import_ply_binary_size),
+        cmocka_unit_test(test_import_off_tokens),
+        cmocka_unit_test(test_import_gltf_dropped_faces),
+        cmocka_unit_test(test_import_not_regular_file),
+        cmocka_unit_test(test_proc_size_range),
         cmocka_unit_test(test_scene_validate),
         cmocka_unit_test(test_lbvh_valid),
         cmocka_unit_test(test_lbvh_equal_codes_share_leaf),

@@ -483,6 +483,15 @@ static void tlist_options(void **state) {
     assert_non_null(strstr(err, "unknown tlist option '4'"));
     assert_int_equal(cbvh_tlist_opts_parse("tlistx", &t, err, sizeof err), -1);
     assert_int_equal(cbvh_tlist_opts_parse("tlist:", &t, err, sizeof err), -1);
+    /* each option group once: the last one would otherwise win silently */
+    static const char *const twice[][2] = {{"tlist:6:2", "a list count given twice"},
+                                           {"tlist:earliest:latest", "an order given twice"},
+                                           {"tlist:cull:8:cull", "cull given twice"},
+                                           {"tlist:heads:heads", "heads given twice"}};
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(cbvh_tlist_opts_parse(twice[i][0], &t, err, sizeof err), -1);
+        if (!strstr(err, twice[i][1]) || strchr(err, '\n')) fail_msg("%s: '%s'", twice[i][0], err);
+    }
 }
 
 /* Cameras: fisheye leaves the corners without rays; thin lens shoots spp
@@ -577,10 +586,19 @@ static void errors(void **state) {
          "\"frames\": 1}}",
          "t.scene: animation.frames: expected an integer in 2..1000"},
         {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"clock_mhz\": 0}}",
-         "t.scene: timing.clock_mhz: 0 is out of range (0, 1e+09]"},
+         "t.scene: timing.clock_mhz: 0 is out of range [0.001, 1e+09]"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"dram_bytes_per_cycle\": 1e-6}}",
+         "t.scene: timing.dram_bytes_per_cycle: 1e-06 is out of range [0.001, 1e+09]"},
         {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"shadows\": true}",
          "t.scene: shadows: unknown field"},
         {"[1, 2]", "t.scene: expected a JSON object at the top level"},
+        {"{\"mesh\": \"" MESH "\", \"mesh\": \"no/such.obj\", " CAMERA ", \"effects\": [\"primary\"]}",
+         "t.scene: mesh: given twice"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"effects\": [\"mirror\"]}",
+         "t.scene: effects: given twice"},
+        {"{\"mesh\": \"" MESH "\", \"camera\": {\"position\": [0,0,1], \"target\": [0,0,0], \"fov\": 40, "
+         "\"fov\": 50}, \"effects\": [\"primary\"]}",
+         "t.scene: camera.fov: given twice"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cbvh_scene_desc d;

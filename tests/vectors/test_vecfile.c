@@ -120,6 +120,21 @@ static void test_missing_file(void **state) {
     expect("no-such-file.vec", CBVH_VEC_E_IO, "no-such-file.vec: cannot open", NULL);
 }
 
+/* Only regular files are read: /dev/zero would be read until memory runs
+ * out, a FIFO would block. */
+static void test_not_regular(void **state) {
+    (void)state;
+    const char *paths[] = {"/dev/zero", FIXTURES};
+    const char *want[] = {"/dev/zero: not a regular file", FIXTURES ": not a regular file (a directory)"};
+    for (int i = 0; i < 2; i++) {
+        if (i == 0 && access(paths[i], R_OK) != 0) continue;
+        cbvh_vecfile vf;
+        cbvh_vec_status st = cbvh_vecfile_load(paths[i], &vf, err, sizeof err);
+        if (st != CBVH_VEC_E_IO || strcmp(err, want[i]) != 0) fail_msg("%s: status %d, message '%s'", paths[i], st, err);
+        assert_null(vf.in);
+    }
+}
+
 /* In-memory variants of a real generated file. */
 static char *gen_text(const char *unit, int bits, size_t *len) {
     cbvh_vecgen_spec s = {cbvh_unit_find(unit), {{bits, -30}, CBVH_ENC_MODULO}, 1, 42};
@@ -495,6 +510,7 @@ int main(void) {
         cmocka_unit_test(test_empty),
         cmocka_unit_test(test_garbage),
         cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_not_regular),
         cmocka_unit_test(test_every_truncation),
         cmocka_unit_test(test_random_damage),
         cmocka_unit_test(test_roundtrip),

@@ -25,10 +25,15 @@ void cbvh_regmap_model_write(void *ctx, uint32_t addr, uint32_t value);
 /* Unit configuration as the datapath decodes the CONFIG register. */
 cbvh_unit_config cbvh_regmap_config(uint32_t config_word);
 
-/* Board addresses: "unix:PATH", "tcp:HOST:PORT", or a bare PATH (contains '/').
- * Returns a connected/listening fd, or -1 with err set. */
+/* Board addresses: "unix:PATH", "tcp:HOST:PORT" (PORT 1..65535), or a bare
+ * PATH (contains '/').  Returns a connected/listening fd, or with err set
+ * CBVH_SIM_BAD_ADDR when the address itself is wrong (syntax, port range, no
+ * such host) and -1 on any other failure. */
+#define CBVH_SIM_BAD_ADDR (-2)
 int cbvh_sim_listen(const char *addr, char *err, size_t errlen);
 int cbvh_sim_connect(const char *addr, char *err, size_t errlen);
+/* Checks an address's syntax and port range only: 0, or -1 with err set. */
+int cbvh_sim_addr_check(const char *addr, char *err, size_t errlen);
 /* Removes a unix socket file created by cbvh_sim_listen. */
 void cbvh_sim_unlink(const char *addr);
 

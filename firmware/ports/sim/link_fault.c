@@ -2,7 +2,9 @@
 #define _GNU_SOURCE
 #include "link_fault.h"
 
+#include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,45 +27,114 @@ static uint64_t next(cbvh_link_fault *f) { /* xorshift64* */
 }
 static double uniform(cbvh_link_fault *f) { return (double)(next(f) >> 11) / 9007199254740992.0; }
 
+/* One "name=value" item's value: a probability, finite and in [0,1]. */
+static int parse_rate(const char *s, double *v) {
+    char *end;
+    errno = 0;
+    double x = strtod(s, &end);
+    if (!*s || isspace((unsigned char)*s) || *end || errno || !isfinite(x) || x < 0 || x > 1) return -1;
+    *v = x;
+    return 0;
+}
+
+/* An unsigned decimal integer, digits only (strtoull alone would take "-1"
+ * as 2^64-1 and skip leading blanks), at most hi. */
+static int parse_uint(const char *s, unsigned long long hi, unsigned long long *v) {
+    if (*s < '0' || *s > '9') return -1;
+    char *end;
+    errno = 0;
+    unsigned long long x = strtoull(s, &end, 10);
+    if (*end || errno == ERANGE || x > hi) return -1;
+    *v = x;
+    return 0;
+}
+
 int cbvh_link_fault_parse(cbvh_link_fault *f, const char *spec, char *err, size_t errlen) {
     cbvh_link_fault_init(f, 1);
     char buf[256];
     if (strlen(spec) >= sizeof buf) {
-        snprintf(err, errlen, "fault spec too long");
+        snprintf(err, errlen, "fault spec too long (at most %zu bytes)", sizeof buf - 1);
+        return -1;
+    }
+    if (!*spec) {
+        snprintf(err, errlen, "empty fault spec");
         return -1;
     }
     strcpy(buf, spec);
-    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+    enum { ALL = CBVH_FAULT_KINDS, DELAY_MS, SEED }; /* item numbers after the fault kinds */
+    unsigned seen = 0; /* bit per item number: a repeated item would silently override the first */
+    double all = 0;
+    for (char *tok = buf, *next_tok; tok; tok = next_tok) {
+        /* split by hand: strtok would skip empty items ("drop=0.1,,dup=0.1") */
+        char *comma = strchr(tok, ',');
+        next_tok = comma ? comma + 1 : NULL;
+        if (comma) *comma = '\0';
         char *eq = strchr(tok, '=');
+        if (!*tok) {
+            snprintf(err, errlen, "fault spec has an empty item");
+            return -1;
+        }
         if (!eq) {
-            snprintf(err, errlen, "fault spec item '%s' lacks '='", tok);
+            snprintf(err, errlen, "fault spec item '%s' is not NAME=VALUE", tok);
             return -1;
         }
         *eq = '\0';
-        char *end;
-        double v = strtod(eq + 1, &end);
-        if (*end || end == eq + 1) {
-            snprintf(err, errlen, "fault spec: bad number for '%s'", tok);
-            return -1;
-        }
+        const char *val = eq + 1;
         int k = -1;
         for (int i = 0; i < CBVH_FAULT_KINDS; i++)
             if (strcmp(tok, cbvh_fault_names[i]) == 0) k = i;
-        if (k >= 0 || strcmp(tok, "all") == 0) {
-            if (v < 0 || v > 1) {
-                snprintf(err, errlen, "fault rate for '%s' must be in [0,1]", tok);
-                return -1;
-            }
-            for (int i = 0; i < CBVH_FAULT_KINDS; i++)
-                if (i == k || k < 0) f->rate[i] = v;
-        } else if (strcmp(tok, "delay_ms") == 0 && v >= 0 && v <= 10000) {
-            f->delay_ms = (int)v;
-        } else if (strcmp(tok, "seed") == 0) {
-            f->rng = (uint64_t)v ? (uint64_t)v : 1;
-        } else {
-            snprintf(err, errlen, "fault spec: unknown item '%s'", tok);
+        int bit = k >= 0                            ? k
+                  : strcmp(tok, "all") == 0         ? ALL
+                  : strcmp(tok, "delay_ms") == 0    ? DELAY_MS
+                  : strcmp(tok, "seed") == 0        ? SEED
+                                                    : -1;
+        if (bit < 0) {
+            snprintf(err, errlen, "fault spec: unknown item '%s' (expected drop, corrupt, dup, trunc, delay, "
+                     "disconnect, all, delay_ms or seed)", tok);
             return -1;
         }
+        if (seen & (1u << bit)) {
+            snprintf(err, errlen, "fault spec: item '%s' given twice", tok);
+            return -1;
+        }
+        seen |= 1u << bit;
+        if (bit <= ALL) {
+            double v;
+            if (parse_rate(val, &v)) {
+                snprintf(err, errlen, "fault spec item '%s=%s': bad value, expected a probability in [0,1]", tok, val);
+                return -1;
+            }
+            if (k >= 0) f->rate[k] = v;
+            else all = v;
+        } else if (bit == DELAY_MS) {
+            unsigned long long v;
+            if (parse_uint(val, CBVH_FAULT_DELAY_MS_MAX, &v)) {
+                snprintf(err, errlen, "fault spec item 'delay_ms=%s': bad value, expected an integer in 0..%d", val,
+                         CBVH_FAULT_DELAY_MS_MAX);
+                return -1;
+            }
+            f->delay_ms = (int)v;
+        } else {
+            unsigned long long v;
+            if (parse_uint(val, UINT64_MAX, &v)) {
+                snprintf(err, errlen, "fault spec item 'seed=%s': bad value, expected a decimal integer in 0..2^64-1",
+                         val);
+                return -1;
+            }
+            f->rng = v ? (uint64_t)v : 1; /* xorshift state must not be 0 */
+        }
+    }
+    /* "all" sets the kinds not named, wherever it stands in the list. */
+    for (int i = 0; i < CBVH_FAULT_KINDS; i++)
+        if (!(seen & (1u << i))) f->rate[i] = all;
+    /* At most one fault per frame, drawn from one uniform number: rates adding
+     * up to more than 1 would starve the kinds listed last. */
+    double sum = 0;
+    for (int i = 0; i < CBVH_FAULT_KINDS; i++) sum += f->rate[i];
+    if (sum > 1 + 1e-9) {
+        snprintf(err, errlen, "fault spec: the rates add up to %g, more than 1 (at most one fault per frame%s)", sum,
+                 seen & (1u << ALL) ? "; all=R gives R to each kind not named" : "");
+        return -1;
     }
     return 0;
 }

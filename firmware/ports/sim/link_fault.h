@@ -20,8 +20,13 @@ typedef struct {
 
 extern const char *const cbvh_fault_names[CBVH_FAULT_KINDS];
 
+#define CBVH_FAULT_DELAY_MS_MAX 10000
+
 /* Parses "drop=0.01,corrupt=0.02,dup=..,trunc=..,delay=..,disconnect=..,
- * delay_ms=N,seed=N" (also "all=R").  0, or -1 with err set. */
+ * delay_ms=N,seed=N" (also "all=R" for the kinds not named).  Strict:
+ * rates in [0,1] adding up to at most 1, delay_ms 0..CBVH_FAULT_DELAY_MS_MAX,
+ * seed a decimal uint64, each item at most once.  0, or -1 with err naming the
+ * item and why. */
 int cbvh_link_fault_parse(cbvh_link_fault *f, const char *spec, char *err, size_t errlen);
 void cbvh_link_fault_init(cbvh_link_fault *f, uint64_t seed);
 

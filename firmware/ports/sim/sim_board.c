@@ -38,17 +38,32 @@ static int parse_addr(const char *addr, sim_addr *a, char *err, size_t errlen) {
     const char *hp = strncmp(addr, "tcp:", 4) == 0 ? addr + 4 : addr;
     const char *colon = strrchr(hp, ':');
     if (!colon || colon == hp || !colon[1] || (size_t)(colon - hp) >= sizeof a->host || strlen(colon + 1) >= sizeof a->port) {
-        snprintf(err, errlen, "bad board address '%s' (expected unix:PATH or tcp:HOST:PORT)", addr);
+        snprintf(err, errlen, "bad board address '%s' (expected unix:PATH, tcp:HOST:PORT or a PATH with '/')", addr);
+        return -1;
+    }
+    /* A decimal port in range: getaddrinfo would take "99999" modulo 65536,
+     * "0" as "any free port" and "http" as a service name. */
+    const char *port = colon + 1;
+    char *end;
+    errno = 0;
+    long pn = *port >= '0' && *port <= '9' ? strtol(port, &end, 10) : -1;
+    if (pn < 1 || pn > 65535 || *end || errno) {
+        snprintf(err, errlen, "bad port '%s' in board address '%s' (expected a number in 1..65535)", port, addr);
         return -1;
     }
     memcpy(a->host, hp, (size_t)(colon - hp));
-    strcpy(a->port, colon + 1);
+    strcpy(a->port, port);
     return 0;
+}
+
+int cbvh_sim_addr_check(const char *addr, char *err, size_t errlen) {
+    sim_addr a;
+    return parse_addr(addr, &a, err, errlen);
 }
 
 static int open_addr(const char *addr, int listening, char *err, size_t errlen) {
     sim_addr a;
-    if (parse_addr(addr, &a, err, errlen)) return -1;
+    if (parse_addr(addr, &a, err, errlen)) return CBVH_SIM_BAD_ADDR;
     if (a.unix_sock) {
         int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
         if (fd < 0) {
@@ -70,11 +85,12 @@ static int open_addr(const char *addr, int listening, char *err, size_t errlen) 
     struct addrinfo hints = {0}, *res = NULL;
     hints.ai_family = AF_UNSPEC;
     hints.ai_socktype = SOCK_STREAM;
-    hints.ai_flags = listening ? AI_PASSIVE : 0;
+    hints.ai_flags = AI_NUMERICSERV | (listening ? AI_PASSIVE : 0);
     int g = getaddrinfo(a.host, a.port, &hints, &res);
     if (g != 0) {
         snprintf(err, errlen, "address %s:%s: %s", a.host, a.port, gai_strerror(g));
-        return -1;
+        /* a host name that does not exist is bad input; a DNS failure is not */
+        return g == EAI_NONAME ? CBVH_SIM_BAD_ADDR : -1;
     }
     int fd = -1;
     for (struct addrinfo *r = res; r; r = r->ai_next) {

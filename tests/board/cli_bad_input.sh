@@ -1,0 +1,103 @@
+#!/bin/sh
+# Bad options and environment of `cbvh board-sim` / `cbvh devices`: each must
+# exit 2 with exactly one line on stderr naming the problem (nothing taken in
+# part, nothing ignored).  A board-sim that does start (on a private socket)
+# is killed after 5 s, which fails the case.
+# Usage: cli_bad_input.sh PATH/TO/cbvh GROUP VECTOR-DIR
+#   GROUP: listen, rx_idle, faults, env, devices_sim; VECTOR-DIR: a valid one, so
+#   that `vectors check` gets as far as opening its backend
+set -u
+cbvh=$1
+group=$2
+vec=$3
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/cbvh-badin-XXXXXX") || exit 1
+trap 'rm -rf "$tmp"' EXIT INT TERM
+fails=0
+
+# expect RC SUBSTRING [VAR=VALUE ...] -- ARGS...
+expect() {
+    want_rc=$1 want=$2
+    shift 2
+    vars=
+    while [ "$1" != "--" ]; do vars="$vars $1"; shift; done
+    shift
+    # shellcheck disable=SC2086
+    env $vars timeout 5 "$cbvh" "$@" >"$tmp/out" 2>"$tmp/err" </dev/null
+    rc=$?
+    lines=$(wc -l <"$tmp/err")
+    if [ "$rc" != "$want_rc" ] || [ "$lines" != 1 ] || ! grep -q -F -- "$want" "$tmp/err"; then
+        echo "FAIL:$vars cbvh $*: exit $rc (want $want_rc), $lines stderr lines (want 1), want '$want' in:"
+        sed 's/^/    /' "$tmp/err"
+        fails=$((fails + 1))
+    else
+        echo "ok:$vars cbvh $*: exit $rc: $(cat "$tmp/err")"
+    fi
+}
+
+case $group in
+listen)
+    expect 2 "--listen: bad port '99999' in board address 'tcp:127.0.0.1:99999' (expected a number in 1..65535)" \
+        -- board-sim --listen tcp:127.0.0.1:99999
+    expect 2 "bad port '0'" -- board-sim --listen tcp:127.0.0.1:0
+    expect 2 "bad port 'http'" -- board-sim --listen tcp:127.0.0.1:http
+    expect 2 "--listen: bad board address 'foo'" -- board-sim --listen foo
+    expect 2 "--listen: bad unix socket path" -- board-sim --listen unix:
+    # a valid address that cannot be listened on is a runtime failure, exit 1
+    expect 1 "listen on $tmp/no/such/dir.sock" -- board-sim --listen "unix:$tmp/no/such/dir.sock"
+    ;;
+rx_idle)
+    expect 2 "--rx-idle-ms expects an integer in 1..60000, got '5x'" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms 5x
+    expect 2 "got '99999999999'" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms 99999999999
+    expect 2 "got '0'" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms 0
+    expect 2 "got '60001'" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms 60001
+    expect 2 "got ''" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms ""
+    ;;
+faults)
+    expect 2 "--faults: fault spec item 'drop=nan': bad value, expected a probability in [0,1]" -- board-sim --listen "unix:$tmp/b.sock" --faults drop=nan
+    expect 2 "item 'delay_ms=-5': bad value, expected an integer in 0..10000" -- board-sim --listen "unix:$tmp/b.sock" --faults delay_ms=-5
+    expect 2 "item 'delay_ms=10001': bad value" -- board-sim --listen "unix:$tmp/b.sock" --faults delay_ms=10001
+    expect 2 "item 'seed=-1': bad value, expected a decimal integer" -- board-sim --listen "unix:$tmp/b.sock" --faults seed=-1
+    expect 2 "item 'seed=1e30': bad value" -- board-sim --listen "unix:$tmp/b.sock" --faults seed=1e30
+    expect 2 "unknown item 'dorp'" -- board-sim --listen "unix:$tmp/b.sock" --faults dorp=0.1
+    expect 2 "rates add up to 3, more than 1" -- board-sim --listen "unix:$tmp/b.sock" --faults all=0.5
+    # the same parser for the host's requests (sim: backend)
+    expect 2 "CBVH_LINK_FAULTS: fault spec item 'drop=nan': bad value" CBVH_LINK_FAULTS=drop=nan \
+        -- vectors check --backend "sim:unix:$tmp/b.sock" "$vec"
+    ;;
+env)
+    expect 2 "cbvh devices: CBVH_USB_VID='zzzz' is not a USB ID (expected 1 to 4 hex digits, optional 0x" \
+        CBVH_USB_VID=zzzz -- devices
+    expect 2 "CBVH_USB_VID='123456' is not a USB ID" CBVH_USB_VID=123456 -- devices
+    expect 2 "CBVH_USB_PID='-1' is not a USB ID" CBVH_USB_PID=-1 -- devices
+    expect 2 "cbvh devices: CBVH_LINK_TIMEOUT_MS='5x' is not valid (expected an integer in 1..600000)" \
+        CBVH_LINK_TIMEOUT_MS=5x -- devices
+    expect 2 "CBVH_LINK_RETRIES='99999999999' is not valid (expected an integer in 0..1000)" \
+        CBVH_LINK_RETRIES=99999999999 -- devices
+    # --backend auto does not fall back to the model over a bad setting
+    expect 2 "CBVH_USB_PID='xyz' is not a USB ID" CBVH_USB_PID=xyz -- vectors check --backend auto "$vec"
+    expect 2 "CBVH_LINK_RETRIES='2x' is not valid" CBVH_LINK_RETRIES=2x \
+        -- vectors check --backend "sim:unix:$tmp/b.sock" "$vec"
+    # the accepted forms still list
+    if CBVH_USB_VID=0x1209 CBVH_USB_PID=C0B1 CBVH_LINK_RETRIES= "$cbvh" devices >"$tmp/out" 2>"$tmp/err" &&
+        grep -q '1209:c0b1' "$tmp/out"; then
+        echo "ok: CBVH_USB_VID=0x1209 CBVH_USB_PID=C0B1 accepted"
+    else
+        echo "FAIL: valid CBVH_USB_VID/PID refused:"; cat "$tmp/err" "$tmp/out"; fails=$((fails + 1))
+    fi
+    ;;
+devices_sim)
+    expect 2 "cbvh devices: --sim: bad board address 'foo' (expected unix:PATH, tcp:HOST:PORT or a PATH with '/')" \
+        -- devices --sim foo
+    expect 2 "--sim: bad port '99999'" -- devices --sim tcp:127.0.0.1:99999
+    expect 2 "cbvh devices: CBVH_SIM_ADDR: bad board address 'foo'" CBVH_SIM_ADDR=foo -- devices
+    # and a sim: backend with a bad address says so, without a `board-sim --listen foo` hint
+    expect 2 "backend 'sim:foo': bad board address 'foo'" -- vectors check --backend sim:foo "$vec"
+    if grep -q "board-sim --listen" "$tmp/err"; then
+        echo "FAIL: the error suggests an invalid board-sim command"; fails=$((fails + 1))
+    fi
+    ;;
+*)
+    echo "unknown group '$group'"; exit 2 ;;
+esac
+[ "$fails" = 0 ] || { echo "$fails case(s) failed"; exit 1; }
+echo "PASS: $group"
