@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <cjson/cJSON.h>
 
@@ -546,6 +547,13 @@ out:
 
 int cbvh_scene_file_load(const char *path, cbvh_scene_desc *d, char *err, size_t errlen) {
     memset(d, 0, sizeof *d);
+    /* A FIFO would block in fopen, a device be read to the size limit. */
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "%s: not a regular file%s, not a scene file", path,
+                 S_ISDIR(st.st_mode) ? " (a directory)" : "");
+        return -1;
+    }
     FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));

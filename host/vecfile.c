@@ -402,29 +402,26 @@ cbvh_vec_status cbvh_vecfile_parse(const char *buf, size_t len, const char *name
 int cbvh_read_file(const char *path, char **buf, size_t *len, char *err, size_t errlen) {
     *buf = NULL;
     *len = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-        return -1;
-    }
-    /* Only regular files of bounded size: /dev/zero, a FIFO or a huge file
-     * would otherwise be read until memory runs out (a directory fails here
-     * too, with a clearer message than a read error). */
+    /* Only regular files of bounded size, checked before opening: /dev/zero
+     * or a huge file would be read until memory runs out, opening a FIFO
+     * blocks, and a directory gets a clearer message than a read error. */
     struct stat st;
-    if (fstat(fileno(f), &st) != 0) {
-        snprintf(err, errlen, "%s: cannot stat: %s", path, strerror(errno));
-        fclose(f);
+    if (stat(path, &st) != 0) {
+        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
     if (!S_ISREG(st.st_mode)) {
         snprintf(err, errlen, "%s: not a regular file%s", path, S_ISDIR(st.st_mode) ? " (a directory)" : "");
-        fclose(f);
         return -1;
     }
     if ((uint64_t)st.st_size > CBVH_READ_MAX_BYTES) {
         snprintf(err, errlen, "%s: %lld bytes, larger than the %llu this tool reads", path, (long long)st.st_size,
                  (unsigned long long)CBVH_READ_MAX_BYTES);
-        fclose(f);
+        return -1;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
     size_t cap = 1 << 16, n = 0;

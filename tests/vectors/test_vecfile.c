@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -124,15 +125,23 @@ static void test_missing_file(void **state) {
  * out, a FIFO would block. */
 static void test_not_regular(void **state) {
     (void)state;
-    const char *paths[] = {"/dev/zero", FIXTURES};
-    const char *want[] = {"/dev/zero: not a regular file", FIXTURES ": not a regular file (a directory)"};
-    for (int i = 0; i < 2; i++) {
-        if (i == 0 && access(paths[i], R_OK) != 0) continue;
+    char fifo[64], fifo_want[128];
+    snprintf(fifo, sizeof fifo, "/tmp/cbvh_test_fifo_%ld.vec", (long)getpid());
+    snprintf(fifo_want, sizeof fifo_want, "%s: not a regular file", fifo);
+    remove(fifo);
+    int have_fifo = mkfifo(fifo, 0600) == 0;
+    alarm(20); /* a FIFO opened for reading would block: fail rather than hang */
+    const char *paths[] = {"/dev/zero", FIXTURES, fifo};
+    const char *want[] = {"/dev/zero: not a regular file", FIXTURES ": not a regular file (a directory)", fifo_want};
+    for (int i = 0; i < 3; i++) {
+        if ((i == 0 && access(paths[i], R_OK) != 0) || (i == 2 && !have_fifo)) continue;
         cbvh_vecfile vf;
         cbvh_vec_status st = cbvh_vecfile_load(paths[i], &vf, err, sizeof err);
         if (st != CBVH_VEC_E_IO || strcmp(err, want[i]) != 0) fail_msg("%s: status %d, message '%s'", paths[i], st, err);
         assert_null(vf.in);
     }
+    alarm(0);
+    if (have_fifo) remove(fifo);
 }
 
 /* In-memory variants of a real generated file. */
