@@ -128,6 +128,7 @@ int cmd_run(int argc, char **argv) {
     co.quiet = 1;
     co.out = json ? stderr : stdout;
     co.summary = &sum;
+    co.who = "cbvh run";
     if (!json) printf("== Golden vectors: %s ==\n", vec_dir);
     const char *paths[1] = {vec_dir};
     int check = cbvh_vectors_check(paths, 1, &co);

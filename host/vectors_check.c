@@ -329,7 +329,7 @@ done:
         fprintf(out, "}\n");
     }
 finish:
-    if (rc == CBVH_CHECK_BAD_INPUT) fprintf(log, "cbvh vectors check: %s\n", err);
+    if (rc == CBVH_CHECK_BAD_INPUT) fprintf(log, "%s: %s\n", o.who ? o.who : "cbvh vectors check", err);
     if (be_open) cbvh_backend_close(&be);
     free(act);
     list_free(&files);

@@ -28,6 +28,7 @@ typedef struct {
     FILE *log;           /* one-line notes and errors (NULL = stderr) */
     size_t batch;        /* vectors per backend call (0 = CBVH_CHECK_BATCH) */
     cbvh_check_summary *summary; /* optional: filled on return */
+    const char *who;     /* prefix of error lines (NULL = "cbvh vectors check") */
 } cbvh_check_opts;
 
 /* Checks directories (MANIFEST verified first, then every listed .vec file)
