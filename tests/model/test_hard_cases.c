@@ -502,6 +502,23 @@ static int case_every_n(void) {
             CHECK(cbvh_nodepair_encode(&p, CBVH_ENC_MODULO, &ctx, in, bytes, eo) & CBVH_ST_BAD_FORMAT,
                   "N=%d: leaf with the empty marker pointer accepted", n);
         }
+        /* an empty child's codes must all be 0: any single code bit set, of
+         * either child, makes the pair BAD_FORMAT (each code field checked) */
+        for (int c = 0; c < 2; c++)
+            for (int bit = 0; bit < 6 * n; bit++) {
+                cbvh_child_in in[2];
+                memset(in, 0, sizeof in);
+                in[0].empty = in[1].empty = 1;
+                uint8_t bytes[24];
+                cbvh_child_out out[2];
+                uint32_t st = cbvh_nodepair_encode(&p, CBVH_ENC_MODULO, &ctx, in, bytes, out);
+                CHECK(st == 0, "N=%d: two empty children: st %#x", n, st);
+                int at = c * w + bit;
+                bytes[at / 8] |= (uint8_t)(1u << (at % 8));
+                st = cbvh_nodepair_decode(&p, CBVH_ENC_MODULO, &ctx, bytes, out);
+                CHECK(st & CBVH_ST_BAD_FORMAT, "N=%d: empty child %d with code bit %d set decoded (st %#x)", n, c, bit,
+                      st);
+            }
     }
     return 0;
 }

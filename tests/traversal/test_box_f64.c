@@ -350,7 +350,9 @@ static void test_pair_decode(void) {
             uint64_t ones = (UINT64_C(1) << pb) - 1u;
             if (k == 0) w = 0; /* empty */
             uint64_t ptr = k < 2 ? ones : rnd() & ones, x = 0;
-            w |= (uint64_t)(k < 2 || (rnd() & 1)) << (pp - 1) | ptr << pp;
+            /* k = 0: the empty marker (leaf, all-ones pointer, codes 0); k = 1: an
+             * all-ones pointer with a random leaf bit: an inner child may have it */
+            w |= (uint64_t)(k == 0 || (rnd() & 1)) << (pp - 1) | ptr << pp;
             if (W == 96) x = ptr >> (64 - pp); /* the pointer's top bits */
             if (below(32) == 0) { /* a reserved or pointer bit */
                 int bit = pp + (int)below((uint32_t)(W - pp));
@@ -410,8 +412,61 @@ static void test_pair_decode(void) {
     }
 }
 
+/* The filter's guard band at its limit: one axis decides t_near with a plane
+ * a few ulps beside o + g d for an M-bit grid value g (others wide open), so
+ * the exact t_near sits next to a rounding boundary of the M-bit result.
+ * Found by mutation testing: an 8-ulp band cut to 1 ulp passed every other
+ * case here (M = 3: filter 24, exact 28). */
+static void test_filter_margin(void) {
+    long decided = 0, n = NBOX;
+    for (long i = 0; i < n; i++) {
+        int M = CBVH_MANT_MIN + (int)below(CBVH_MANT_MAX - CBVH_MANT_MIN + 1);
+        float o = (float)((tu_unit_d(&rs) * 2 - 1) * ldexp(1, (int)below(20) - 10));
+        float d = (float)((tu_unit_d(&rs) * 2 - 1) * ldexp(1, (int)below(10) - 5));
+        if (d == 0) continue;
+        double g = ldexp(1 + floor(tu_unit_d(&rs) * ldexp(1, M - 1)) / ldexp(1, M - 1), (int)below(10) - 5);
+        cbvh_f32 pb = fb((float)(o + g * d)) + (uint32_t)((int)below(9) - 4); /* a few ulps beside */
+        float P = bf(pb);
+        if (!isfinite(P)) continue;
+        cbvh_ray ray;
+        ray.o[0] = fb(o);
+        ray.d[0] = fb(d);
+        ray.o[1] = ray.o[2] = 0;
+        ray.d[1] = ray.d[2] = fb(1e-3f);
+        ray.tmin = fb(-1e30f);
+        ray.tmax = CBVH_F32_POS_INF;
+        float lo[3] = {d > 0 ? P : P - fabsf(P) - 1e6f, -1e20f, -1e20f};
+        float hi[3] = {d > 0 ? P + fabsf(P) + 1e6f : P, 1e20f, 1e20f};
+        cbvh_f32 flo[3], fhi[3];
+        double dlo[3], dhi[3];
+        for (int a = 0; a < 3; a++) {
+            flo[a] = fb(lo[a]);
+            fhi[a] = fb(hi[a]);
+            dlo[a] = lo[a];
+            dhi[a] = hi[a];
+        }
+        cbvh_rbf_ray p;
+        cbvh_rbf_prepare(&ray, M, &p);
+        int hit = 0;
+        double tn = 0;
+        int dec = cbvh_rbf_box(&p, HUGE_VAL, dlo, dhi, &hit, &tn);
+        decided += dec;
+        cbvh_box_result ex;
+        uint32_t st = cbvh_ray_box_float_exact_only(&ray, M, flo, fhi, &ex);
+        if (!hit_ok(dec, hit, tn, st, &ex) && failures++ < 10)
+            printf("FAIL margin case %ld: M=%d o=%a d=%a P=%a: filter hit=%d tn=%a, exact st=%x hit=%d tn=%08x\n", i, M,
+                   (double)o, (double)d, (double)P, hit, tn, st, ex.hit, ex.t_near);
+    }
+    printf("planes beside the M-bit grid: %ld rays, filter decided %ld\n", n, decided);
+    if (decided < n / 2) {
+        printf("FAIL: the filter decided too few margin cases\n");
+        failures++;
+    }
+}
+
 int main(void) {
     test_float_boxes();
+    test_filter_margin();
     test_grid_boxes();
     test_pair_decode();
     printf("box pairs with valid planes (cbvh_rbf_box2_valid checked): %ld\n", n_valid_pairs);

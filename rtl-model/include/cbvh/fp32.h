@@ -43,7 +43,8 @@ cbvh_f32 cbvh_f32_add_dyadic(int64_t a, int ea, int64_t b, int eb, cbvh_rnd mode
 /* Total order of finite values: -1, 0, 1 (+0 == -0). */
 int cbvh_f32_cmp(cbvh_f32 a, cbvh_f32 b);
 
-/* Next binary32 toward +Inf / -Inf (finite inputs; -0 treated as +0). */
+/* Next binary32 toward +Inf / -Inf (finite inputs; -0 treated as +0; a zero
+ * result is +0, e.g. next_up(-min subnormal), where IEEE nextUp gives -0). */
 cbvh_f32 cbvh_f32_next_up(cbvh_f32 b);
 cbvh_f32 cbvh_f32_next_down(cbvh_f32 b);
 
