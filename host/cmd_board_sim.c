@@ -1,5 +1,4 @@
 /* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
-#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +7,7 @@
 
 #include "cbvh_sim.h"
 #include "commands.h"
+#include "parse_int.h"
 
 static volatile int stop_flag;
 static void on_signal(int sig) {
@@ -16,17 +16,6 @@ static void on_signal(int sig) {
 }
 
 #define RX_IDLE_MS_MAX 60000
-
-/* Strict decimal integer in lo..hi: atoi took "5x" as 5 and wrapped huge
- * values; strtol alone would skip leading blanks. */
-static int parse_int(const char *s, long lo, long hi, int *out) {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if ((*s != '-' && (*s < '0' || *s > '9')) || *end || errno || v < lo || v > hi) return -1;
-    *out = (int)v;
-    return 0;
-}
 
 static void usage(FILE *f) {
     fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--faults SPEC] [--rx-idle-ms N] [--break-unit UNIT] [--verbose]\n"
@@ -55,11 +44,13 @@ int cmd_board_sim(int argc, char **argv) {
         } else if (strcmp(argv[i], "--faults") == 0 && i + 1 < argc) {
             faults = argv[++i];
         } else if (strcmp(argv[i], "--rx-idle-ms") == 0 && i + 1 < argc) {
-            if (parse_int(argv[++i], 1, RX_IDLE_MS_MAX, &idle)) {
+            long v;
+            if (cbvh_parse_long(argv[++i], 1, RX_IDLE_MS_MAX, &v)) {
                 fprintf(stderr, "cbvh board-sim: --rx-idle-ms expects an integer in 1..%d, got '%s'\n",
                         RX_IDLE_MS_MAX, argv[i]);
                 return 2;
             }
+            idle = (int)v;
         } else if (strcmp(argv[i], "--break-unit") == 0 && i + 1 < argc) {
             const cbvh_unit *u = cbvh_unit_find(argv[++i]);
             if (!u) {

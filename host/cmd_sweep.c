@@ -16,6 +16,7 @@
 #include "chart_svg.h"
 #include "commands.h"
 #include "image_png.h"
+#include "parse_int.h"
 #include "sweep.h"
 
 #define MAX_HEAT 16
@@ -51,15 +52,6 @@ static void usage(FILE *f) {
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
 }
 
-static int parse_long(const char *s, long lo, long hi, long *out) {
-    char *end;
-    errno = 0;
-    long v = s && *s ? strtol(s, &end, 10) : 0;
-    if (!s || !*s || *end || errno || v < lo || v > hi) return -1;
-    *out = v;
-    return 0;
-}
-
 static int is_int(const char *s) {
     if (*s == '-' || *s == '+') s++;
     if (!*s) return 0;
@@ -90,7 +82,7 @@ static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, l
         snprintf(buf, sizeof buf, "%s", a);
         for (char *t = strtok(buf, ","); t; t = strtok(NULL, ",")) {
             long v;
-            if (parse_long(t, lo, hi, &v)) {
+            if (cbvh_parse_long(t, lo, hi, &v)) {
                 fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%s'\n", opt, lo, hi, t);
                 return -1;
             }
@@ -158,7 +150,7 @@ static int parse_heat(const char *s, heat_spec *h) {
     if (n != 1 && n != 3) return -1;
     if (strlen(s) >= sizeof buf) return -1;
     for (int i = 0; i < n; i++)
-        if (parse_long(p[i], -126, 126, &v[i])) return -1;
+        if (cbvh_parse_long(p[i], -126, 126, &v[i])) return -1;
     if (v[0] < CBVH_N_MIN || v[0] > CBVH_N_MAX) return -1;
     h->bits = (int)v[0];
     if (n == 3) {
@@ -291,10 +283,10 @@ int cmd_sweep(int argc, char **argv) {
             int bad;
             if (dd) {
                 *dd = 0;
-                bad = parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo) || parse_long(dd + 2, CBVH_N_MIN, CBVH_N_MAX, &hi) ||
+                bad = cbvh_parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo) || cbvh_parse_long(dd + 2, CBVH_N_MIN, CBVH_N_MAX, &hi) ||
                       lo > hi;
             } else {
-                bad = parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo);
+                bad = cbvh_parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo);
                 hi = lo;
             }
             if (bad || strlen(v) >= sizeof buf) {
@@ -312,7 +304,7 @@ int cmd_sweep(int argc, char **argv) {
                 return 2;
         } else if (strcmp(a, "--spp") == 0) {
             long v;
-            if (parse_long(i + 1 < argc ? argv[i + 1] : NULL, 1, 1024, &v)) {
+            if (cbvh_parse_long(i + 1 < argc ? argv[i + 1] : NULL, 1, 1024, &v)) {
                 fprintf(stderr, "cbvh sweep: --spp expects an integer in 1..1024, got '%s'\n",
                         i + 1 < argc ? argv[i + 1] : "");
                 return 2;
@@ -320,7 +312,7 @@ int cmd_sweep(int argc, char **argv) {
             i++;
             o.spp = (int)v;
         } else if (strcmp(a, "--knee") == 0) {
-            if (parse_long(i + 1 < argc ? argv[i + 1] : NULL, 0, 1000, &knee_pct)) {
+            if (cbvh_parse_long(i + 1 < argc ? argv[i + 1] : NULL, 0, 1000, &knee_pct)) {
                 fprintf(stderr, "cbvh sweep: --knee expects a percentage in 0..1000, got '%s'\n",
                         i + 1 < argc ? argv[i + 1] : "");
                 return 2;
@@ -402,7 +394,7 @@ int cmd_sweep(int argc, char **argv) {
             char buf[64];
             snprintf(buf, sizeof buf, "%s", corrupt);
             char *c = strchr(buf, ':');
-            if (!c || (*c = 0, parse_long(buf, 0, 100000, &si)) || parse_long(c + 1, 0, 2000000000L, &ri)) {
+            if (!c || (*c = 0, cbvh_parse_long(buf, 0, 100000, &si)) || cbvh_parse_long(c + 1, 0, 2000000000L, &ri)) {
                 fprintf(stderr, "cbvh sweep: --test-corrupt expects SETTING:RAY, got '%s'\n", corrupt);
                 return 2;
             }

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "effects.h"
+#include "parse_int.h"
 #include "scene_file.h"
 #include "timing_model.h"
 
@@ -36,9 +37,8 @@ static void usage(FILE *f) {
 }
 
 static int parse_int(const char *opt, const char *s, long lo, long hi, int *out) {
-    char *end;
-    long v = s ? strtol(s, &end, 10) : 0;
-    if (!s || !*s || *end || v < lo || v > hi) {
+    long v;
+    if (cbvh_parse_long(s, lo, hi, &v)) {
         fprintf(stderr, "cbvh trace: %s expects an integer in %ld..%ld, got '%s'\n", opt, lo, hi, s ? s : "");
         return -1;
     }

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "manifest.h"
+#include "parse_int.h"
 #include "vecfile.h"
 #include "vecgen.h"
 #include "vectors_check.h"
@@ -58,15 +59,6 @@ static void usage_check(FILE *f) {
                "\nExit status: 0 all pass, 1 mismatches, 2 bad input (unknown unit, bad header, bad hex,\n"
                "wrong field count, hash mismatch, missing file...).\n",
             CBVH_CHECK_BATCH);
-}
-
-static int parse_long(const char *s, int base, long lo, long hi, long *v) {
-    char *end;
-    errno = 0;
-    long x = strtol(s, &end, base);
-    if (errno || end == s || *end || x < lo || x > hi) return -1;
-    *v = x;
-    return 0;
 }
 
 /* Writes one file through a temp file + rename; returns its SHA-256. */
@@ -131,7 +123,7 @@ static int cmd_gen(int argc, char **argv) {
             }
             break;
         case 'l':
-            if (parse_long(optarg, 10, 1, 2, &v)) {
+            if (cbvh_parse_long(optarg, 1, 2, &v)) {
                 fprintf(stderr, "cbvh vectors gen: --level must be 1 or 2, not '%s'\n", optarg);
                 return 2;
             }
@@ -149,14 +141,14 @@ static int cmd_gen(int argc, char **argv) {
             break;
         }
         case 'n':
-            if (parse_long(optarg, 10, CBVH_N_MIN, CBVH_N_MAX, &v)) {
+            if (cbvh_parse_long(optarg, CBVH_N_MIN, CBVH_N_MAX, &v)) {
                 fprintf(stderr, "cbvh vectors gen: --bits must be %d..%d, not '%s'\n", CBVH_N_MIN, CBVH_N_MAX, optarg);
                 return 2;
             }
             sel.bits = (int)v;
             break;
         case 'm':
-            if (parse_long(optarg, 10, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &v)) {
+            if (cbvh_parse_long(optarg, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &v)) {
                 fprintf(stderr, "cbvh vectors gen: --min-scale must be %d..%d, not '%s'\n", CBVH_SCALE_FLOOR,
                         CBVH_SCALE_CEIL, optarg);
                 return 2;
@@ -259,7 +251,7 @@ static int cmd_check(int argc, char **argv) {
         switch (c) {
         case 'b': o.backend = optarg; break;
         case 'M':
-            if (parse_long(optarg, 10, 0, INT_MAX, &v)) {
+            if (cbvh_parse_long(optarg, 0, INT_MAX, &v)) {
                 fprintf(stderr, "cbvh vectors check: --max-errors must be a count >= 0, not '%s'\n", optarg);
                 return 2;
             }

@@ -1,7 +1,7 @@
 /* Host side of the board protocol: see protocol.h and docs/protocol.md. */
 #include "protocol.h"
+#include "parse_int.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,10 +30,8 @@ void cbvh_link_init(cbvh_link *l, const cbvh_link_io *io) {
 static int env_int(const char *name, long lo, long hi, int *v, char *err, size_t errlen) {
     const char *s = getenv(name);
     if (!s || !*s) return 0;
-    char *end;
-    errno = 0;
-    long x = strtol(s, &end, 10);
-    if (*s < '0' || *s > '9' || *end || errno || x < lo || x > hi) {
+    long x;
+    if (cbvh_parse_long(s, lo, hi, &x)) {
         snprintf(err, errlen, "%s='%.40s' is not valid (expected an integer in %ld..%ld)", name, s, lo, hi);
         return -1;
     }

@@ -83,22 +83,23 @@ static int hidt_reopen(void *ctx, char *err, size_t errlen) {
 }
 
 static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t errlen) {
-    uint16_t vid, pid;
-    /* Bad settings fail the open before any device is looked for. */
-    if (cbvh_usb_identity(&vid, &pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen))
-        return CBVH_BACKEND_ERROR;
-    if (hid_init() != 0) {
-        snprintf(err, errlen, "hid_init failed");
-        return CBVH_BACKEND_NONE;
-    }
     hid_state *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
-        hid_exit();
         return CBVH_BACKEND_ERROR;
     }
-    s->vid = vid;
-    s->pid = pid;
+    cbvh_link_io io = {s, hidt_write, hidt_read, hidt_reopen};
+    cbvh_link_init(&s->link, &io);
+    /* Bad settings fail the open before any device is looked for. */
+    if (cbvh_usb_identity(&s->vid, &s->pid, err, errlen) || cbvh_link_env_options(&s->link, err, errlen)) {
+        free(s);
+        return CBVH_BACKEND_ERROR;
+    }
+    if (hid_init() != 0) {
+        snprintf(err, errlen, "hid_init failed");
+        free(s);
+        return CBVH_BACKEND_NONE;
+    }
     if (arg && *arg) {
         mbstowcs(s->serial, arg, sizeof s->serial / sizeof s->serial[0] - 1);
         s->use_serial = 1;
@@ -109,9 +110,6 @@ static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t er
         hid_exit();
         return none ? CBVH_BACKEND_NONE : CBVH_BACKEND_ERROR;
     }
-    cbvh_link_io io = {s, hidt_write, hidt_read, hidt_reopen};
-    cbvh_link_init(&s->link, &io);
-    cbvh_link_env_options(&s->link, err, errlen); /* checked above */
     cbvh_link_flush(&s->link, 20);
     char why[200];
     if (cbvh_link_identify(&s->link, why, sizeof why)) {
@@ -122,7 +120,7 @@ static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t er
         return CBVH_BACKEND_ERROR;
     }
     const cbvh_identity *id = &s->link.ident;
-    snprintf(b->label, sizeof b->label, "hid %04x:%04x %s (fw %u.%u.%u, datapath v%u)", vid, pid, id->board_name,
+    snprintf(b->label, sizeof b->label, "hid %04x:%04x %s (fw %u.%u.%u, datapath v%u)", s->vid, s->pid, id->board_name,
              id->fw_major, id->fw_minor, id->fw_patch, (unsigned)id->datapath_version);
     b->state = s;
     return CBVH_BACKEND_OK;

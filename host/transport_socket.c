@@ -60,11 +60,16 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
     }
     /* A wrong address or setting is reported as such, not as "no board
      * (start one with ...)" with a hint that would fail the same way. */
-    if (cbvh_sim_addr_check(arg, err, errlen) || cbvh_link_env_options(NULL, err, errlen))
-        return CBVH_BACKEND_ERROR;
+    if (cbvh_sim_addr_check(arg, err, errlen)) return CBVH_BACKEND_ERROR;
     sim_state *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
+        return CBVH_BACKEND_ERROR;
+    }
+    cbvh_link_io io = {s, sock_write, sock_read, sock_reopen};
+    cbvh_link_init(&s->link, &io);
+    if (cbvh_link_env_options(&s->link, err, errlen)) {
+        free(s);
         return CBVH_BACKEND_ERROR;
     }
     snprintf(s->addr, sizeof s->addr, "%s", arg);
@@ -88,9 +93,6 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         free(s);
         return CBVH_BACKEND_ERROR;
     }
-    cbvh_link_io io = {s, sock_write, sock_read, sock_reopen};
-    cbvh_link_init(&s->link, &io);
-    cbvh_link_env_options(&s->link, err, errlen); /* checked above */
     cbvh_link_flush(&s->link, 5);
     if (cbvh_link_identify(&s->link, why, sizeof why)) {
         snprintf(err, errlen, "virtual board at %s: %s", s->addr, why);

@@ -130,8 +130,10 @@ static int usb_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         return CBVH_BACKEND_ERROR;
     }
     if (arg) snprintf(s->serial, sizeof s->serial, "%s", arg);
+    cbvh_link_io io = {s, usb_write, usb_read, usb_reopen};
+    cbvh_link_init(&s->link, &io);
     /* Bad settings fail the open before any device is looked for. */
-    if (cbvh_usb_identity(&s->vid, &s->pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen)) {
+    if (cbvh_usb_identity(&s->vid, &s->pid, err, errlen) || cbvh_link_env_options(&s->link, err, errlen)) {
         free(s);
         return CBVH_BACKEND_ERROR;
     }
@@ -147,9 +149,6 @@ static int usb_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         free(s);
         return none ? CBVH_BACKEND_NONE : CBVH_BACKEND_ERROR;
     }
-    cbvh_link_io io = {s, usb_write, usb_read, usb_reopen};
-    cbvh_link_init(&s->link, &io);
-    cbvh_link_env_options(&s->link, err, errlen); /* checked above */
     cbvh_link_flush(&s->link, 20); /* stale IN packets from an earlier session */
     char why[200];
     if (cbvh_link_identify(&s->link, why, sizeof why)) {
