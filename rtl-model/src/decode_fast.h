@@ -8,11 +8,11 @@
  * nodes whose decode by the unit (cbvh_nodepair_decode) returns status 0:
  * valid parameters and contexts, no reserved bit set, empty children with
  * zero codes, r < s on every axis.  It then returns 1 with the same leaf,
- * empty, ptr as the unit,
- * and r, s equal to cbvh_axis_store_codes(RELATIVE) of the unit's outputs
- * (s = 0 read as 2^N), as the traversal used them.  Otherwise it returns 0
- * and the caller runs the unit.  tests/traversal/test_box_f64.c compares
- * both on random and hard node pairs. */
+ * empty, ptr as the unit, and r, s equal to cbvh_axis_store_codes(RELATIVE)
+ * of the unit's outputs (s = 0 read as 2^N), as the traversal used them.
+ * Otherwise it returns 0 and the caller runs the unit.
+ * tests/traversal/test_box_f64.c compares both on random and hard node
+ * pairs. */
 #ifndef CBVH_DECODE_FAST_H
 #define CBVH_DECODE_FAST_H
 
