@@ -34,14 +34,16 @@ static void usage_gen(FILE *f) {
             "  -u, --unit U           one unit (");
     for (int i = 0; i < cbvh_unit_count; i++) fprintf(f, "%s%s", i ? ", " : "", cbvh_units[i]->name);
     fprintf(f, ")\n"
-               "  -l, --level 1|2        1: structured corner cases (default); 2: plus %d random vectors per file\n"
+               "  -l, --level 1|2        1: structured corner cases, random cases and, for the ray units,\n"
+               "                         exact-path cases (default); 2: plus %d random vectors per file\n"
+               "                         and %d more exact-path cases per ray file\n"
                "  -s, --seed S           generator seed, hex or decimal (default 0x%016" PRIX64 ")\n"
                "  -n, --bits N           coordinate bits, %d..%d (default: all)\n"
                "  -m, --min-scale E      minimum scale, %d..%d (default %d)\n"
                "  -e, --encoding E       modulo or relative (default: both)\n"
                "  -o, --output DIR       output directory (created if missing)\n"
                "  -h, --help             this text\n",
-            CBVH_VECGEN_LEVEL2_RANDOM, CBVH_VECGEN_DEFAULT_SEED, CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR,
+            CBVH_VECGEN_LEVEL2_RANDOM, CBVH_VECGEN_LEVEL2_EXACT, CBVH_VECGEN_DEFAULT_SEED, CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR,
             CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
 }
 

@@ -1078,6 +1078,273 @@ static void gen_qbvh_stack(gen_t *g, size_t target) {
     }
 }
 
+/* ---- exact-path cases (docs/vectors.md, "Exact-path cases") ----------------------
+ *
+ * The ray units' fast paths and binary64 filters decide most inputs; an RTL
+ * implementation has only the exact datapath, and its hard cases are the ones
+ * the filters leave to the model's exact path: exact ties (a ray through an
+ * edge or vertex, a tangent, a segment ending on a sphere), quotients that are
+ * exactly representable or land on the M-bit grid, results next to the
+ * binary32 subnormal border, and planes or origins beyond 62-bit fixed point.
+ * These are built constructively from small integers scaled by powers of two,
+ * so every case is exact by construction (not selected by running the
+ * model: the files do not depend on the model's fast paths), from a stream
+ * of their own so the random part before and level 2's part after are those
+ * of generator 1.  tests/vectors/test_exact_paths.c checks how many of them
+ * reach the exact path. */
+
+#define EXACT_CASES_BOX 400
+#define EXACT_CASES_TRI 400
+#define EXACT_CASES_SPHERE 300
+
+/* A random odd integer with exactly `bits` bits (bits >= 2). */
+static int64_t rnd_odd_bits(rng_t *r, int bits) {
+    return (int64_t)(((uint64_t)1 << (bits - 1)) | (rng_next(r) & (((uint64_t)1 << (bits - 1)) - 1)) | 1u);
+}
+/* A random normal float of either sign with exponent in [elo, ehi] (one draw
+ * per statement: argument order is unspecified). */
+static cbvh_f32 rnd_f32_in(rng_t *r, int elo, int ehi) {
+    int sign = (int)rnd_below(r, 2);
+    int e = (int)rnd_range(r, elo, ehi);
+    uint32_t frac = (uint32_t)rng_next(r);
+    return mkf(sign, e, frac);
+}
+/* x nudged by one ulp either way, or unchanged (2 in 3). */
+static cbvh_f32 nudge(rng_t *r, cbvh_f32 x) {
+    switch (rnd_below(r, 6)) {
+    case 0: return up(x);
+    case 1: return down(x);
+    default: return x;
+    }
+}
+
+static void exact_ray_box(gen_t *g, rng_t *rng, int count) {
+    for (int i = 0; i < count && !g->oom; i++) {
+        cbvh_f32 o[3], d[3], u[3], tmin = 0, tmax = CBVH_F32_POS_INF;
+        int e[3];
+        uint32_t r[3], s[3];
+        int mant = (int)rnd_range(rng, CBVH_MANT_MIN, CBVH_MANT_MAX);
+        switch (i % 3) {
+        case 0: { /* plane distances that are exact multiples of a non-power-of-two d:
+                   * t = j 2^p, on the M-bit grid whenever j has <= M bits */
+            int p = (int)rnd_range(rng, -20, 20);
+            int64_t jn[3] = {0, 0, 0};
+            for (int a = 0; a < 3; a++) {
+                e[a] = (int)rnd_range(rng, -30, 10);
+                int64_t ui = rnd_below(rng, 2) ? rnd_range(rng, -(1 << 16), 1 << 16) : 0;
+                u[a] = dyadic(ui, e[a]);
+                if (rnd_below(rng, 4) == 0) { /* parallel, origin inside the slab or on a face */
+                    r[a] = (uint32_t)rnd_range(rng, 0, 1000);
+                    s[a] = r[a] + (uint32_t)rnd_range(rng, 1, 1024 - r[a]);
+                    int64_t c = rnd_range(rng, r[a], s[a]);
+                    o[a] = dyadic(ui + c, e[a]);
+                    d[a] = rnd_below(rng, 2) ? 0 : CBVH_F32_SIGN;
+                    continue;
+                }
+                int64_t m = rnd_odd_bits(rng, (int)rnd_range(rng, 2, 7));
+                int64_t j1 = rnd_range(rng, 0, 4), j2 = j1 + rnd_range(rng, 1, 8);
+                while (m * (j2 - j1) > 1024) m = 3;
+                r[a] = (uint32_t)rnd_range(rng, 0, 1024 - m * (j2 - j1));
+                s[a] = r[a] + (uint32_t)(m * (j2 - j1));
+                int neg = (int)rnd_below(rng, 2);
+                int64_t c = neg ? (int64_t)s[a] + m * j1 : (int64_t)r[a] - m * j1;
+                o[a] = dyadic(ui + c, e[a]);
+                d[a] = dyadic(neg ? -m : m, e[a] - p);
+                jn[a] = j1;
+            }
+            uint64_t tk = rnd_below(rng, 4);
+            if (tk == 1) tmin = dyadic(jn[rnd_below(rng, 3)], p); /* tmin on an entry distance */
+            if (tk == 2) tmax = dyadic(jn[rnd_below(rng, 3)], p); /* tmax on one */
+            break;
+        }
+        case 1: { /* an origin far from a box around 0: L - O needs more than 62 bits */
+            uint32_t k = (uint32_t)rnd_range(rng, 0, 6); /* the far axes' d = -o 2^(k-3): all at t = 2^(3-k) */
+            for (int a = 0; a < 3; a++) {
+                e[a] = (int)rnd_range(rng, -30, 0);
+                r[a] = (uint32_t)rnd_range(rng, 0, 500);
+                s[a] = r[a] + 2 * (uint32_t)rnd_range(rng, 1, 250);
+                u[a] = dyadic(-(int64_t)(r[a] + s[a]) / 2, e[a]); /* 0 is the box's centre */
+                uint64_t kind = rnd_below(rng, 3);
+                if (kind == 0 && a != 0) { /* inside, slow */
+                    o[a] = dyadic(rnd_range(rng, -(int64_t)(s[a] - r[a]) / 2, (int64_t)(s[a] - r[a]) / 2), e[a]);
+                    d[a] = rnd_f32_in(rng, -40, -10);
+                } else { /* far, aimed back at 0 (t = 2^(3-k)), sometimes an ulp off */
+                    o[a] = rnd_f32_in(rng, 40, 123);
+                    d[a] = nudge(rng, (o[a] ^ CBVH_F32_SIGN) + ((k << 23) - (3u << 23)));
+                }
+            }
+            break;
+        }
+        default: { /* planes at the ends of the range: grids from u = -Inf (-2^128) or
+                    * -FLT_MAX at scale 2^126 around an origin up to 2^126 (distances
+                    * that overflow binary32), or planes past +FLT_MAX */
+            for (int a = 0; a < 3; a++) {
+                uint64_t kind = rnd_below(rng, 5);
+                o[a] = rnd_f32_in(rng, 100, 125);
+                d[a] = rnd_f32_in(rng, -20, 20);
+                if (kind < 4) { /* [u + r 2^126, u + s 2^126] contains o */
+                    u[a] = kind < 2 ? CBVH_F32_NEG_INF : CBVH_F32_MAX | CBVH_F32_SIGN;
+                    e[a] = 126;
+                    r[a] = (uint32_t)rnd_range(rng, 0, 3);
+                    s[a] = (uint32_t)rnd_range(rng, 5, 16);
+                } else { /* past FLT_MAX, the ray heading there */
+                    u[a] = CBVH_F32_MAX;
+                    e[a] = (int)rnd_range(rng, 100, 126);
+                    r[a] = (uint32_t)rnd_range(rng, 0, 16);
+                    s[a] = r[a] + (uint32_t)rnd_range(rng, 1, 16);
+                    d[a] &= ~CBVH_F32_SIGN;
+                }
+            }
+            break;
+        }
+        }
+        if (cbvh_f32_is_zero(d[0]) && cbvh_f32_is_zero(d[1]) && cbvh_f32_is_zero(d[2])) d[0] = F_ONE;
+        emit_ray_box(g, o, d, tmin, tmax, mant, u, e, r, s);
+    }
+}
+
+/* Triangle vertices as 4x integers V[3][3], a point P4 (4x) on it and a ray
+ * o = P - k D, d = D 2^sd (t = k 2^-sd exactly, k = 0 included), all scaled
+ * by 2^(s-2). */
+static void exact_tri_lattice(gen_t *g, rng_t *rng, int kind) {
+    int64_t V[3][3], P4[3], D[3];
+    int s = (int)rnd_range(rng, -24, 24), sd = (int)rnd_range(rng, -8, 8);
+    for (int i = 0; i < 3; i++)
+        for (int a = 0; a < 3; a++) V[i][a] = 4 * rnd_range(rng, -64, 64);
+    int i0 = (int)rnd_below(rng, 3), i1 = (i0 + 1) % 3, i2 = (i0 + 2) % 3;
+    for (int a = 0; a < 3; a++) {
+        if (kind == 0) P4[a] = V[i0][a];                                     /* a vertex */
+        else if (kind == 1) P4[a] = (V[i0][a] + V[i1][a]) / 2;               /* an edge's midpoint */
+        else if (kind == 2) P4[a] = (V[i0][a] + V[i1][a] + 2 * V[i2][a]) / 4; /* inside, exact */
+        else P4[a] = (3 * V[i0][a] + V[i1][a]) / 4;                          /* on an edge, off centre */
+    }
+    do
+        for (int a = 0; a < 3; a++) D[a] = rnd_range(rng, -8, 8);
+    while (!D[0] && !D[1] && !D[2]);
+    int64_t k = rnd_range(rng, 0, 16); /* k = 0: the origin on the triangle, t = 0 (not a hit) */
+    int64_t off = rnd_below(rng, 4) == 0 ? rnd_range(rng, 1 << 20, 1 << 21) : 0; /* far along axis ax */
+    int ax = (int)rnd_below(rng, 3);
+    cbvh_f32 o[3], d[3], v[9];
+    for (int a = 0; a < 3; a++) {
+        int64_t sh = a == ax ? off : 0;
+        for (int i = 0; i < 3; i++) v[3 * i + a] = dyadic(V[i][a] + sh, s - 2);
+        o[a] = dyadic(P4[a] - 4 * k * D[a] + sh, s - 2);
+        d[a] = dyadic(4 * D[a], s - 2 + sd);
+    }
+    if (rnd_below(rng, 3) == 0) { /* an ulp off: tiny nonzero edge functions */
+        int a = (int)rnd_below(rng, 3);
+        if (!cbvh_f32_is_zero(d[a])) d[a] = nudge(rng, d[a]);
+    }
+    emit_ray_tri(g, o, d, v);
+}
+
+static void exact_ray_triangle(gen_t *g, rng_t *rng, int count) {
+    for (int i = 0; i < count && !g->oom; i++) {
+        int fam = i % 6;
+        if (fam < 4) {
+            exact_tri_lattice(g, rng, fam);
+            continue;
+        }
+        /* the binary32 subnormal border: t (family 4) or b1, b2 (family 5) just
+         * below or above 2^-126, as truncations of inexact quotients */
+        int ax = (int)rnd_below(rng, 3), bx = (ax + 1) % 3, cx = (ax + 2) % 3; /* the plane's normal is ax */
+        int j = (int)rnd_range(rng, -2, 2);
+        int64_t m = 3; /* legs of 3 2^j: inexact barycentrics */
+        cbvh_f32 o[3], d[3], v[9] = {0};
+        v[3 + bx] = dyadic(m, j); /* v0 = 0, v1 = m 2^j e_b, v2 = m 2^j e_c */
+        v[6 + cx] = dyadic(m, j);
+        int64_t dm = rnd_odd_bits(rng, (int)rnd_range(rng, 2, 3)); /* 3, 5, 7 */
+        if (rnd_below(rng, 4) == 0) dm = 1;
+        int dj = (int)rnd_range(rng, -2, 2);
+        /* the small input: anywhere below 2^-121, or a full significand that puts
+         * the quotient within a factor 4 of 2^-126 (divisor dm 2^dj or m 2^j) */
+        int64_t tiny;
+        int te;
+        if (rnd_below(rng, 2)) {
+            int bits = (int)rnd_range(rng, 1, 24);
+            tiny = (int64_t)((uint64_t)1 << (bits - 1) | (rng_next(rng) & (((uint64_t)1 << (bits - 1)) - 1)));
+            te = -149 + (int)rnd_range(rng, 0, 4);
+        } else {
+            tiny = rnd_odd_bits(rng, 24);
+            te = -150 + (fam == 4 ? (dm > 4 ? 3 : dm > 1 ? 2 : 0) + dj : 2 + j) + (int)rnd_range(rng, -2, 1);
+            if (te < -149) te = -149;
+        }
+        int sgn = rnd_below(rng, 5) == 0; /* sometimes the other side: a miss decided by an exact sign */
+        if (fam == 4) {
+            o[bx] = dyadic(1, j - 2);
+            o[cx] = dyadic(1, j - 2);
+            o[ax] = dyadic(sgn ? -tiny : tiny, te);
+            d[bx] = d[cx] = 0;
+            d[ax] = dyadic(-dm, dj);
+        } else {
+            int which = (int)rnd_below(rng, 2);
+            o[which ? cx : bx] = dyadic(sgn ? -tiny : tiny, te);
+            o[which ? bx : cx] = dyadic(1, j - 2);
+            o[ax] = F_ONE;
+            d[bx] = d[cx] = 0;
+            d[ax] = dyadic(-dm, dj); /* t = 1 / (dm 2^dj): inexact but for dm = 1 */
+        }
+        emit_ray_tri(g, o, d, v);
+    }
+}
+
+/* Pythagorean triples a^2 + b^2 = c^2: exact distances from small integers. */
+static const int pyth[][3] = {{3, 4, 5}, {5, 12, 13}, {8, 15, 17}, {7, 24, 25}, {20, 21, 29}};
+
+static void exact_ray_sphere(gen_t *g, rng_t *rng, int count) {
+    for (int i = 0; i < count && !g->oom; i++) {
+        const int *tr = pyth[rnd_below(rng, sizeof pyth / sizeof pyth[0])];
+        int ax = (int)rnd_below(rng, 3), bx = (ax + 1) % 3, cx = (ax + 2) % 3;
+        int s = (int)rnd_range(rng, -20, 20), sd = (int)rnd_range(rng, -6, 6);
+        int64_t C[3], k = rnd_range(rng, 1, 8), Dv[3] = {0, 0, 0}, Ov[3];
+        for (int a = 0; a < 3; a++) C[a] = rnd_range(rng, -100, 100);
+        cbvh_f32 tmin = 0, tmax = CBVH_F32_POS_INF;
+        if (i % 2 == 0) { /* a tangent line: d = (a, b, 0), offset k c along the third axis or (-b, a, 0) */
+            Dv[ax] = tr[0];
+            Dv[bx] = tr[1];
+            int64_t jj = rnd_range(rng, -10, 10);
+            for (int a = 0; a < 3; a++) Ov[a] = C[a] - jj * Dv[a];
+            if (rnd_below(rng, 2)) Ov[cx] += k * tr[2];
+            else {
+                Ov[ax] -= k * tr[1];
+                Ov[bx] += k * tr[0];
+            }
+            /* t* = jj 2^(s-(s+sd)); put a segment end on it, beside it, or none */
+            cbvh_f32 ts = dyadic(jj, -sd);
+            switch (rnd_below(rng, 4)) {
+            case 1: tmax = jj >= 0 ? ts : CBVH_F32_POS_INF; break;
+            case 2: tmin = ts; break;
+            default: break;
+            }
+        } else { /* a segment that ends (or starts) exactly on the sphere: P = C + k (a, b, 0) */
+            do
+                for (int a = 0; a < 3; a++) Dv[a] = rnd_range(rng, -8, 8);
+            while (!Dv[0] && !Dv[1] && !Dv[2]);
+            /* at P the segment must only touch: heading in at its end (tmax), out at its start (tmin) */
+            int at_end = (int)rnd_below(rng, 2);
+            int64_t dot = Dv[ax] * tr[0] + Dv[bx] * tr[1];
+            if ((at_end && dot > 0) || (!at_end && dot < 0))
+                for (int a = 0; a < 3; a++) Dv[a] = -Dv[a];
+            int64_t t0 = rnd_range(rng, 1, 8);
+            for (int a = 0; a < 3; a++) Ov[a] = C[a] - t0 * Dv[a];
+            Ov[ax] += k * tr[0];
+            Ov[bx] += k * tr[1];
+            cbvh_f32 te = dyadic(t0, -sd);
+            if (at_end) tmax = te;
+            else tmin = te;
+        }
+        cbvh_f32 o[3], d[3], c[3];
+        for (int a = 0; a < 3; a++) {
+            o[a] = dyadic(Ov[a], s);
+            c[a] = dyadic(C[a], s);
+            d[a] = dyadic(Dv[a], s + sd);
+        }
+        cbvh_f32 r = dyadic(k * tr[2], s);
+        if (rnd_below(rng, 5) == 0) r = nudge(rng, r);
+        emit_ray_sphere(g, o, d, tmin, tmax, c, r);
+    }
+}
+
 /* ---- files ------------------------------------------------------------------- */
 
 /* Vectors of a level-1 file per unit (the committed set stays small). */
@@ -1135,10 +1402,19 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     else if (strcmp(s->unit->name, "qbvh_stack") == 0) fn = gen_qbvh_stack;
     else if (strcmp(s->unit->name, "ray_sphere") == 0) fn = gen_ray_sphere;
     if (!fn) return -1;
+    void (*exact)(gen_t *, rng_t *, int) = NULL;
+    int n_exact = 0;
+    if (fn == gen_ray_box) exact = exact_ray_box, n_exact = EXACT_CASES_BOX;
+    if (fn == gen_ray_triangle) exact = exact_ray_triangle, n_exact = EXACT_CASES_TRI;
+    if (fn == gen_ray_sphere) exact = exact_ray_sphere, n_exact = EXACT_CASES_SPHERE;
     fn(&g, target);
+    rng_t ex; /* generator 2: the exact-path cases, from a stream of their own */
+    rng_seed(&ex, s->seed ^ h ^ UINT64_C(0xE7AC7CA5E5000002));
+    if (exact) exact(&g, &ex, n_exact);
     if (s->level >= 2) {
         g.random_only = 1;
         fn(&g, g.n + CBVH_VECGEN_LEVEL2_RANDOM);
+        if (exact) exact(&g, &ex, CBVH_VECGEN_LEVEL2_EXACT);
     }
     if (g.oom) {
         free(g.in);

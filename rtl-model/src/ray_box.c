@@ -371,3 +371,11 @@ int cbvh_ray_box_float_fast_only(const cbvh_ray *ray, int M, const cbvh_f32 lo[3
     if (prep_status(&p, ray->tmax, M) | float_status(lo, hi)) return -1;
     return fast_float(&p, ray->tmax, M, lo, hi, out);
 }
+
+cbvh_unit_path cbvh_ray_box_path(const cbvh_ray *ray, int M, const cbvh_grid_axis axis[3]) {
+    cbvh_rb_ray p;
+    cbvh_box_result out;
+    cbvh_rb_prepare(ray, &p);
+    if (prep_status(&p, ray->tmax, M) | grid_status(axis)) return CBVH_PATH_REJECT;
+    return fast_grid(&p, ray->tmax, M, axis, &out) == 0 ? CBVH_PATH_FAST : CBVH_PATH_EXACT;
+}

@@ -289,3 +289,8 @@ int cbvh_ray_sphere_fast_terms(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f3
     fp_end(&f, tmax, &y[4], &ay[4]);
     return 5;
 }
+
+cbvh_unit_path cbvh_ray_sphere_path(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r) {
+    if (check(ray, c, r) || empty_segment(ray)) return CBVH_PATH_REJECT;
+    return fast_decide(ray, c, r) >= 0 ? CBVH_PATH_FAST : CBVH_PATH_EXACT;
+}

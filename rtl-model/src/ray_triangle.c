@@ -293,3 +293,12 @@ int cbvh_ray_triangle_filter_hit(const cbvh_ray *ray, const cbvh_f32 v0[3], cons
     cbvh_tri_ray_prepare(ray, &p);
     return filter(&p, v0, v1, v2, 1, out) == 2;
 }
+
+cbvh_unit_path cbvh_ray_triangle_path(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
+                                      const cbvh_f32 v2[3]) {
+    cbvh_tri_ray p;
+    cbvh_tri_result r;
+    cbvh_tri_ray_prepare(ray, &p);
+    if (!p.ok || verts_bad(v0, v1, v2)) return CBVH_PATH_REJECT;
+    return filter(&p, v0, v1, v2, 1, &r) ? CBVH_PATH_FAST : CBVH_PATH_EXACT;
+}

@@ -75,6 +75,21 @@ uint32_t cbvh_ray_sphere(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r, i
  * datapath port (no vectors). */
 int cbvh_tri_facing(const cbvh_f32 d[3], const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3]);
 
+/* Which of the model's computations produces a unit's outputs for these
+ * inputs.  The outputs never depend on it (the fast paths return only what
+ * they prove equal to the exact path's); it tells the vector generator and
+ * the coverage test which inputs exercise the integer-defined exact path,
+ * where the hard cases are (docs/vectors.md, "Exact-path cases"). */
+typedef enum {
+    CBVH_PATH_REJECT = 0, /* a nonzero status (or, sphere: an empty segment) */
+    CBVH_PATH_FAST = 1,   /* a fast path or binary64 filter decided */
+    CBVH_PATH_EXACT = 2   /* the exact path decided */
+} cbvh_unit_path;
+cbvh_unit_path cbvh_ray_box_path(const cbvh_ray *ray, int mant_bits, const cbvh_grid_axis axis[3]);
+cbvh_unit_path cbvh_ray_triangle_path(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
+                                      const cbvh_f32 v2[3]);
+cbvh_unit_path cbvh_ray_sphere_path(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r);
+
 /* Total order key of a binary32 value incl. +-Inf (+0 == -0); NaN not allowed. */
 static inline int64_t cbvh_f32_key(cbvh_f32 x) {
     return (x & CBVH_F32_SIGN) ? -(int64_t)(x & ~CBVH_F32_SIGN) : (int64_t)x;
