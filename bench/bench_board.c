@@ -89,9 +89,15 @@ int main(int argc, char **argv) {
     snprintf(addr, sizeof addr, "unix:%s", sock);
     snprintf(spec, sizeof spec, "sim:%s", addr);
     board_thread *bt = calloc(1, sizeof *bt);
+    if (!bt) {
+        fprintf(stderr, "bench_board: out of memory\n");
+        return 1;
+    }
     bt->fd = cbvh_sim_listen(addr, err, sizeof err);
     if (bt->fd < 0) {
         fprintf(stderr, "bench_board: %s\n", err);
+        free(bt);
+        rmdir(dir);
         return 1;
     }
     pthread_create(&bt->th, NULL, board_main, bt);

@@ -74,7 +74,7 @@ int main(int argc, char **argv) {
         if (cbvh_scene_open(specs[i], &s, err, sizeof err)) die(specs[i], err);
         cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 4, 0};
         double best_l = 1e30, best_bu = 1e30, best_td = 1e30, best_c = 1e30, best_run = 1e30, best_f = 1e30,
-               fr[100];
+               fr[100] = {0};
         size_t cb = 0, fb = 0;
         for (int r = 0; r < reps; r++) {
             cbvh_bvh b;

@@ -254,8 +254,8 @@ int main(int argc, char **argv) {
                     double head_kib = (double)L.ntris * p.nlists * 4 / 1024;
                     cbvh_trav_mode mode = cull ? CBVH_TRAV_CLOSEST_FRONT : CBVH_TRAV_CLOSEST;
                     for (int heads = 0; heads < 4; heads++) { /* bit 0: per-polygon, bit 1: per-cell */
-                        timing one, keep;
-                        double best_tl = 1e30, best_b = 1e30, ratio[100];
+                        timing one, keep = {0};
+                        double best_tl = 1e30, best_b = 1e30, ratio[100] = {0};
                         for (int k = 0; k < reps; k++) {
                             run_pair(&b, &L, s.tris, R, n, mode, heads, cell_head, hb[cull], ht, &one);
                             ratio[k] = one.bvh_secs / one.tl_secs;

@@ -187,7 +187,7 @@ int main(int argc, char **argv) {
             for (int mode = 0; mode < 2; mode++) {
                 /* repetitions interleave the three tracers so that load changes on
                  * the shared machine hit all of them alike; best time of each */
-                cbvh_trav_stats sb, sc_, sf;
+                cbvh_trav_stats sb = {0}, sc_ = {0}, sf = {0};
                 result rb = {0, 0}, rc = {0, 0}, re = {0, 0}, rf = {0, 0};
                 for (int k = 0; k < reps; k++) {
                     result y = run_ours(2, &b, &fb, &t, s.tris, rr, n, (cbvh_trav_mode)mode, 1, &sf);

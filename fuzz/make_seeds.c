@@ -2,14 +2,21 @@
  *   cc -std=c11 -Ifirmware/include fuzz/make_seeds.c firmware/core/frame.c -o /tmp/make_seeds && /tmp/make_seeds fuzz/corpus
  * (fuzz/corpus/vecfile holds cut-down copies of files in vectors/.) */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "cbvh_fw/frame.h"
 static uint8_t buf[8192];
 static size_t frame(uint8_t *at, uint8_t cmd, uint8_t st, uint16_t seq, const uint8_t *p, uint16_t n) {
-    memcpy(at + CBVH_FRAME_HDR, p, n);
+    if (n) memcpy(at + CBVH_FRAME_HDR, p, n); /* p may be NULL when n == 0 */
     return cbvh_frame_seal(at, cmd, st, seq, n);
 }
-static void put(const char *path, const uint8_t *p, size_t n) { FILE *f = fopen(path, "wb"); fwrite(p, 1, n, f); fclose(f); }
+static void put(const char *path, const uint8_t *p, size_t n) {
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(p, 1, n, f) != n || fclose(f) != 0) {
+        perror(path);
+        exit(1);
+    }
+}
 int main(int argc, char **argv) {
     (void)argc;
     char path[512];

@@ -220,6 +220,7 @@ static void stats3(const scene_result *r, int nr, size_t off, int col, double ou
     out[0] = INFINITY, out[1] = -INFINITY, out[2] = 0;
     int k = 0;
     for (int i = 0; i < nr; i++) {
+        /* cppcheck-suppress invalidPointerCast ; off = offsetof(scene_result, a double array) */
         double v = ((const double *)((const char *)&r[i] + off))[col];
         if (isnan(v)) continue;
         if (v < out[0]) out[0] = v;
@@ -240,6 +241,7 @@ static void print_block(const char *title, const scene_result *r, int nr, size_t
     printf("\n");
     for (int i = 0; i < nr; i++) {
         printf("%-26.26s", r[i].name);
+        /* cppcheck-suppress invalidPointerCast ; off = offsetof(scene_result, a double array) */
         const double *v = (const double *)((const char *)&r[i] + off);
         for (int c = 0; c < ncol; c++) isnan(v[c]) ? printf(" %6s", "-") : printf(" %6.3f", v[c]);
         printf("\n");

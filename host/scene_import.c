@@ -20,16 +20,26 @@ static void xform(const struct aiMatrix4x4 *m, const struct aiVector3D *v, float
     out[2] = m->c1 * v->x + m->c2 * v->y + m->c3 * v->z + m->c4;
 }
 
+/* Row-major copies: indexing past &m->a1 would be pointer arithmetic outside
+ * the member a1, which C leaves undefined even though the fields are adjacent. */
+static void to_rows(const struct aiMatrix4x4 *m, float x[16]) {
+    const float v[16] = {m->a1, m->a2, m->a3, m->a4, m->b1, m->b2, m->b3, m->b4,
+                         m->c1, m->c2, m->c3, m->c4, m->d1, m->d2, m->d3, m->d4};
+    memcpy(x, v, sizeof v);
+}
+
 static struct aiMatrix4x4 mul(const struct aiMatrix4x4 *a, const struct aiMatrix4x4 *b) {
-    const float *x = &a->a1, *y = &b->a1;
-    struct aiMatrix4x4 r;
-    float *z = &r.a1;
+    float x[16], y[16], z[16];
+    to_rows(a, x);
+    to_rows(b, y);
     for (int i = 0; i < 4; i++)
         for (int j = 0; j < 4; j++) {
             float s = 0.0f;
             for (int k = 0; k < 4; k++) s += x[i * 4 + k] * y[k * 4 + j];
             z[i * 4 + j] = s;
         }
+    struct aiMatrix4x4 r = {z[0], z[1], z[2],  z[3],  z[4],  z[5],  z[6],  z[7],
+                            z[8], z[9], z[10], z[11], z[12], z[13], z[14], z[15]};
     return r;
 }
 

@@ -38,7 +38,12 @@ static void do_identify(cbvh_fw *fw, uint16_t seq) {
 }
 
 static void do_status(cbvh_fw *fw, uint16_t seq) {
-    const uint32_t *c = &fw->n.frames_ok;
+    /* listed field by field: indexing past &n.frames_ok would be undefined
+     * (pointer arithmetic outside one member), adjacent fields or not */
+    const cbvh_fw_counters *n = &fw->n;
+    const uint32_t c[CBVH_FW_COUNTERS] = {n->frames_ok,     n->error_replies, n->crc_errors,
+                                          n->sync_errors,   n->header_errors, n->rx_timeouts,
+                                          n->vectors,       n->batches,       n->datapath_errors};
     for (unsigned i = 0; i < CBVH_FW_COUNTERS; i++) cbvh_put32(fw->tx + CBVH_FRAME_HDR + 4 * i, c[i]);
     reply(fw, CBVH_CMD_STATUS, CBVH_E_OK, seq, 4 * CBVH_FW_COUNTERS);
 }

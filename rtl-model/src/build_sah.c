@@ -102,6 +102,7 @@ int cbvh_build_sah(const cbvh_scene *s, int bins, int max_leaf, cbvh_bvh *out, c
                 for (int k = 0; k < bins - 1; k++) {
                     box_grow(&acc, &bb[k]);
                     c += bc[k];
+                    /* cppcheck-suppress uninitvar ; rcnt[1 .. bins-1] were set by the loop above */
                     if (c == 0 || rcnt[k + 1] == 0) continue;
                     double cost = box_area(&acc) * c + rarea[k + 1] * rcnt[k + 1];
                     if (cost < best) best = cost, best_axis = a, best_bin = k;

@@ -407,6 +407,7 @@ general:;
         cbvh_child_in_of(n, slot[0], &in[0]);
         in[1].empty = 1;
     } else {
+        /* cppcheck-suppress nullPointer ; leaf == (cn_in == NULL) */
         for (int c = 0; c < 2; c++) cbvh_child_in_of(cn_in[c], slot[c], &in[c]);
     }
     st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);

@@ -162,6 +162,37 @@ static void test_import_gltf_morph(void **st) {
     cbvh_scene_free(&s);
 }
 
+/* Nested node transforms compose parent x child: a parent scaled by 2 and
+ * rotated 90 degrees about z over a child translated by +1 in x puts the
+ * child's vertex (1, 0, 0) at R S (v + t) = (0, 4, 0); the other order gives
+ * (0, 3, 0) and no rotation (4, 0, 0). */
+static void test_import_gltf_nested_nodes(void **st) {
+    (void)st;
+    float buf[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    char enc[100], gltf[2048];
+    base64((const uint8_t *)buf, sizeof buf, enc);
+    snprintf(gltf, sizeof gltf,
+             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+             "\"nodes\":[{\"children\":[1],\"scale\":[2,2,2],\"rotation\":[0,0,0.70710678,0.70710678]},"
+             "{\"mesh\":0,\"translation\":[1,0,0]}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]}]}",
+             enc);
+    cbvh_scene s;
+    no_error(import_text("n.gltf", gltf, &s));
+    assert_int_equal(s.ntris, 1);
+    assert_float_equal(s.tris[0].v[0][0], 0.0f, 1e-5f); /* (0,0,0) + t -> (1,0,0) -> (2,0,0) -> (0,2,0) */
+    assert_float_equal(s.tris[0].v[0][1], 2.0f, 1e-5f);
+    assert_float_equal(s.tris[0].v[1][0], 0.0f, 1e-5f);
+    assert_float_equal(s.tris[0].v[1][1], 4.0f, 1e-5f);
+    assert_float_equal(s.tris[0].v[2][0], -2.0f, 1e-5f); /* (0,1,0) + t = (1,1,0) -> (2,2,0) -> (-2,2,0) */
+    assert_float_equal(s.tris[0].v[2][1], 2.0f, 1e-5f);
+    cbvh_scene_free(&s);
+}
+
 static void expect_import_error(const char *suffix, const char *text, const char *needle) {
     cbvh_scene s;
     errbuf[0] = 0;
@@ -854,6 +885,7 @@ int main(void) {
         cmocka_unit_test(test_import_bunny),
         cmocka_unit_test(test_import_formats),
         cmocka_unit_test(test_import_gltf_morph),
+        cmocka_unit_test(test_import_gltf_nested_nodes),
         cmocka_unit_test(test_import_errors),
         cmocka_unit_test(test_import_ply_counts),
         cmocka_unit_test(test_import_ply_binary_size),

@@ -21,8 +21,10 @@ void *memcpy(void *d, const void *s, size_t n) {
 }
 
 void Reset_Handler(void) {
-    for (uint32_t *s = &__data_load, *d = &__data_start; d < &__data_end;) *d++ = *s++;
-    for (uint32_t *d = &__bss_start; d < &__bss_end;) *d++ = 0;
+    /* the linker's symbols are separate objects to C: compare addresses as integers */
+    const uint32_t *s = &__data_load;
+    for (uintptr_t d = (uintptr_t)&__data_start; d < (uintptr_t)&__data_end; d += 4) *(uint32_t *)d = *s++;
+    for (uintptr_t d = (uintptr_t)&__bss_start; d < (uintptr_t)&__bss_end; d += 4) *(uint32_t *)d = 0;
     main();
     for (;;) {}
 }
