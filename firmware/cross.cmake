@@ -4,7 +4,8 @@
 #                      flash/RAM use is printed and checked against a budget.
 #   cbvh-selftest.elf  firmware core + model on mps2-an385 (Cortex-M3), run
 #                      under qemu with semihosting; its reply digest must equal
-#                      the host build's.
+#                      the host build's, and it must pass every golden vector
+#                      of vectors/ (the model without unsigned __int128).
 option(CBVH_FIRMWARE_CROSS "Cross-compile the firmware images when arm-none-eabi-gcc is found" ON)
 find_program(CBVH_ARM_GCC arm-none-eabi-gcc)
 find_program(CBVH_ARM_SIZE arm-none-eabi-size)
@@ -54,7 +55,7 @@ if(CBVH_ARM_GCC AND CBVH_ARM_SIZE AND CBVH_FIRMWARE_CROSS)
   if(CBVH_QEMU_ARM)
     add_test(NAME firmware_qemu_selftest
              COMMAND sh ${fw_dir}/scripts/run_qemu_selftest.sh ${CMAKE_BINARY_DIR} ${CBVH_QEMU_ARM} ${selftest_elf}
-                     $<TARGET_FILE:fw_selftest_host>)
+                     $<TARGET_FILE:fw_selftest_host> ${PROJECT_SOURCE_DIR}/vectors)
   else()
     add_test(NAME firmware_qemu_selftest
              COMMAND sh -c "echo 'SKIP: qemu-system-arm not installed (apt-get install qemu-system-arm)'; exit 77")
