@@ -7,7 +7,7 @@
  *   - the bit-exact CBVH traversal (N = 6 modulo, M = 24),
  * closest hit and any hit, one core, as ratios to Embree.
  *
- * usage: bench_traverse [--rays R] [--seed S] [--reps K] [SCENE...]
+ * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]
  *   SCENE as for `cbvh study` (mesh file or proc:NAME[:SIZE]); default: the
  *   bundled bunny.  R rays per kind (default 20000): camera rays (pinhole, a
  *   square image looking at the scene centre from outside its box) and random
@@ -15,7 +15,10 @@
  *   seeded.  Times are the best of K repetitions (default 3), the tracers
  *   interleaved within each repetition.
  * Embree's device is created with threads=1; the traversal loop runs on the
- * calling thread for every tracer. */
+ * calling thread for every tracer.  --embree-isa limits Embree to one
+ * instruction set (Embree's "isa=" setting: sse2, sse4.2, avx, avx2, avx512);
+ * by default it picks the widest the CPU has, while our code is built for the
+ * x86-64 baseline (SSE2), so sse2 compares like with like. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -136,14 +139,21 @@ int main(int argc, char **argv) {
     uint64_t seed = 1;
     const char *specs[64];
     int ns = 0;
+    const char *isa = NULL;
     for (int i = 1; i < argc; i++) {
         if (int_option(argc, argv, &i, "--rays", 2, 10000000, &nrays) ||
             int_option(argc, argv, &i, "--reps", 1, 100, &reps))
             continue;
         if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
             seed = strtoull(argv[++i], NULL, 0);
+        } else if (!strcmp(argv[i], "--embree-isa") && i + 1 < argc) {
+            isa = argv[++i];
+            static const char *const known[] = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
+            int ok = 0;
+            for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) ok |= !strcmp(isa, known[k]);
+            if (!ok) die("--embree-isa", "must be sse2, sse4.2, avx, avx2 or avx512");
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: bench_traverse [--rays R] [--seed S] [--reps K] [SCENE...]\n");
+            fprintf(stderr, "usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]\n");
             return 2;
         } else if (ns < 64) {
             specs[ns++] = argv[i];
@@ -153,8 +163,11 @@ int main(int argc, char **argv) {
     rs = seed * 0x9E3779B97F4A7C15u + 0x2545F4914F6CDD1Du;
     if (!rs) rs = 1;
 #ifdef CBVH_HAVE_EMBREE
-    RTCDevice dev = rtcNewDevice("threads=1");
+    char config[64];
+    snprintf(config, sizeof config, "threads=1%s%s", isa ? ",isa=" : "", isa ? isa : "");
+    RTCDevice dev = rtcNewDevice(config);
     if (!dev) die("embree", "rtcNewDevice failed");
+    printf("embree device: %s\n", config);
 #else
     printf("(built without Embree: no baseline, absolute rays/s only)\n");
 #endif
