@@ -399,6 +399,33 @@ static void decode_chain(gen_t *g, box_t root, int extras) {
     }
 }
 
+/* Generator 2, after the random part (no draws: level 1's random part and
+ * level 2's are unchanged): contexts whose lower bound clb has its lowest
+ * significand bit d = 33..40 binades above or below the scale, around the
+ * widest alignment u + r 2^e that fits a 64-bit datapath (the model's fast
+ * path takes |d| <= 36), with codes for the first, last and whole-node cells. */
+static void decode_alignment_limits(gen_t *g) {
+    static const uint32_t fracs[4] = {0, CBVH_F32_FRAC, 0x400001u, 0x123457u};
+    for (int d = -40; d <= 40; d++) {
+        if (d > -33 && d < 33) continue;
+        for (int v = 0; v < 4; v++) {
+            cbvh_axis_ctx c;
+            c.scale = g->ms + 7 * v;
+            int eu = c.scale + d + 150; /* biased exponent of clb */
+            if (c.scale > CBVH_SCALE_CEIL || eu < 1 || eu > 254) continue;
+            c.parent_scale = c.scale + v % 3 > CBVH_SCALE_CEIL ? c.scale : c.scale + v % 3;
+            c.lb_mod = (uint32_t)v & g->mask;
+            c.clb = ((v & 2) ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << 23 | fracs[v];
+            int shift = c.parent_scale - c.scale;
+            uint32_t pmod = shift >= g->N ? 0 : (c.lb_mod << shift) & g->mask;
+            uint32_t r = (uint32_t)v % 3u, sc = g->mask + 1u - (uint32_t)(v % 2); /* r < s <= 2^N */
+            int modulo = g->spec->cfg.enc == CBVH_ENC_MODULO;
+            uint32_t lc = modulo ? (r + pmod) & g->mask : r, uc = modulo ? (sc + pmod) & g->mask : sc & g->mask;
+            emit_decode(g, &c, lc, uc);
+        }
+    }
+}
+
 static void gen_decode(gen_t *g, size_t target) {
     const cbvh_params *p = &g->spec->cfg.params;
     uint32_t full = g->mask + 1u;
@@ -463,6 +490,7 @@ static void gen_decode(gen_t *g, size_t target) {
     }
     /* Then chains from random roots, every fourth from a structured one. */
     for (int i = 0; g->n < target && !g->oom; i++) decode_chain(g, pick_root(g, i % 4 == 0 ? (i / 4) % N_ROOT : N_ROOT), 1);
+    if (!g->random_only) decode_alignment_limits(g);
 }
 
 /* ---- node pairs -------------------------------------------------------------- */
