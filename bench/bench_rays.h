@@ -51,6 +51,43 @@ static inline int int_option(int argc, char **argv, int *i, const char *name, in
     return 1;
 }
 
+/* The command line of the traversal-vs-Embree benches:
+ *   [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]
+ * (isa: Embree's isa= setting; NULL = Embree's own choice).  Exits 2 with the
+ * usage on an unknown option, 1 on a bad value; no scene = the bundled bunny. */
+typedef struct {
+    int nrays, reps;
+    uint64_t seed;
+    const char *isa;
+    const char *specs[64];
+    int ns;
+} bench_args;
+
+static inline void bench_parse(int argc, char **argv, bench_args *a, const char *default_scene) {
+    for (int i = 1; i < argc; i++) {
+        if (int_option(argc, argv, &i, "--rays", 2, 10000000, &a->nrays) ||
+            int_option(argc, argv, &i, "--reps", 1, 100, &a->reps))
+            continue;
+        if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
+            a->seed = strtoull(argv[++i], NULL, 0);
+        } else if (!strcmp(argv[i], "--embree-isa") && i + 1 < argc) {
+            a->isa = argv[++i];
+            static const char *const known[] = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
+            int ok = 0;
+            for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) ok |= !strcmp(a->isa, known[k]);
+            if (!ok) die("--embree-isa", "must be sse2, sse4.2, avx, avx2 or avx512");
+        } else if (argv[i][0] == '-') {
+            fprintf(stderr, "usage: " BENCH_NAME " [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]\n");
+            exit(2);
+        } else if (a->ns < 64) {
+            a->specs[a->ns++] = argv[i];
+        }
+    }
+    if (!a->ns) a->specs[a->ns++] = default_scene;
+    rs = a->seed * 0x9E3779B97F4A7C15u + 0x2545F4914F6CDD1Du; /* the rays' generator */
+    if (!rs) rs = 1;
+}
+
 /* Open a scene and build its binned-SAH float BVH; `build` names the step in
  * the error message. */
 static inline void load_scene(const char *spec, cbvh_scene *s, cbvh_bvh *b, const char *build) {

@@ -33,7 +33,7 @@
 #include "bench_rays.h"
 
 #ifdef CBVH_HAVE_EMBREE
-#include <embree3/rtcore.h>
+#include "bench_embree.h"
 #endif
 
 #ifndef CBVH_SCENES_DIR
@@ -76,98 +76,21 @@ static result run_embree(RTCScene sc, const cbvh_ray *rays, int n, int occluded,
     result res = {0, 0};
     double best = 1e30;
     for (int k = 0; k < reps; k++) {
-        long hits = 0;
-        double t0 = now();
-        for (int i = 0; i < n; i++) {
-            struct RTCIntersectContext ctx;
-            rtcInitIntersectContext(&ctx);
-            struct RTCRayHit rh;
-            rh.ray.org_x = bf(rays[i].o[0]);
-            rh.ray.org_y = bf(rays[i].o[1]);
-            rh.ray.org_z = bf(rays[i].o[2]);
-            rh.ray.dir_x = bf(rays[i].d[0]);
-            rh.ray.dir_y = bf(rays[i].d[1]);
-            rh.ray.dir_z = bf(rays[i].d[2]);
-            rh.ray.tnear = 0;
-            rh.ray.tfar = INFINITY;
-            rh.ray.time = 0;
-            rh.ray.mask = 0xFFFFFFFFu;
-            rh.ray.id = 0;
-            rh.ray.flags = 0;
-            if (occluded) {
-                rtcOccluded1(sc, &ctx, &rh.ray);
-                hits += rh.ray.tfar < 0;
-            } else {
-                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-                rtcIntersect1(sc, &ctx, &rh);
-                hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-            }
-        }
-        double dt = now() - t0;
+        double dt = embree_trace(sc, rays, n, occluded, &res.hits);
         if (dt < best) best = dt;
-        res.hits = hits;
     }
     res.rays_per_s = n / best;
     return res;
 }
-
-static RTCScene embree_scene(RTCDevice dev, const cbvh_scene *s) {
-    RTCScene sc = rtcNewScene(dev);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                        (size_t)s->ntris * 3);
-    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                           s->ntris);
-    if (!vb || !ib) die("embree", "buffer allocation failed");
-    for (uint32_t i = 0; i < s->ntris; i++)
-        for (int k = 0; k < 3; k++) {
-            for (int a = 0; a < 3; a++) vb[(size_t)9 * i + 3 * k + a] = s->tris[i].v[k][a];
-            ib[(size_t)3 * i + k] = 3 * i + (unsigned)k;
-        }
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(sc, g);
-    rtcReleaseGeometry(g);
-    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
-    rtcCommitScene(sc);
-    return sc;
-}
 #endif
 
 int main(int argc, char **argv) {
-    int nrays = 20000, reps = 3;
-    uint64_t seed = 1;
-    const char *specs[64];
-    int ns = 0;
-    const char *isa = NULL;
-    for (int i = 1; i < argc; i++) {
-        if (int_option(argc, argv, &i, "--rays", 2, 10000000, &nrays) ||
-            int_option(argc, argv, &i, "--reps", 1, 100, &reps))
-            continue;
-        if (!strcmp(argv[i], "--seed") && i + 1 < argc) {
-            seed = strtoull(argv[++i], NULL, 0);
-        } else if (!strcmp(argv[i], "--embree-isa") && i + 1 < argc) {
-            isa = argv[++i];
-            static const char *const known[] = {"sse2", "sse4.2", "avx", "avx2", "avx512"};
-            int ok = 0;
-            for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) ok |= !strcmp(isa, known[k]);
-            if (!ok) die("--embree-isa", "must be sse2, sse4.2, avx, avx2 or avx512");
-        } else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]\n");
-            return 2;
-        } else if (ns < 64) {
-            specs[ns++] = argv[i];
-        }
-    }
-    if (!ns) specs[ns++] = CBVH_SCENES_DIR "/bunny-small.obj";
-    rs = seed * 0x9E3779B97F4A7C15u + 0x2545F4914F6CDD1Du;
-    if (!rs) rs = 1;
+    bench_args A = {.nrays = 20000, .reps = 3, .seed = 1};
+    bench_parse(argc, argv, &A, CBVH_SCENES_DIR "/bunny-small.obj");
+    int nrays = A.nrays, reps = A.reps, ns = A.ns;
+    const char *const *specs = A.specs;
 #ifdef CBVH_HAVE_EMBREE
-    char config[64];
-    snprintf(config, sizeof config, "threads=1%s%s", isa ? ",isa=" : "", isa ? isa : "");
-    RTCDevice dev = rtcNewDevice(config);
-    if (!dev) die("embree", "rtcNewDevice failed");
-    printf("embree device: %s\n", config);
+    RTCDevice dev = embree_device(A.isa);
 #else
     printf("(built without Embree: no baseline, absolute rays/s only)\n");
 #endif
