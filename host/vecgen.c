@@ -1104,6 +1104,20 @@ static void gen_qbvh_stack(gen_t *g, size_t target) {
         }
         emit_qstack(g, 0, first, mask, t, 0);
     }
+    if (g->random_only) return;
+    /* Generator 2, after the random part (no draws): NaN and Inf in the lanes
+     * that did not hit (ignored, not rejected) for every mask, and the first
+     * child ID at 2^26 - 1, 2^26 and 2^26 + 1 for masks with 0..4 hits. */
+    static const cbvh_f32 odd[4] = {0x7FC00000u, 0x7F800001u, CBVH_F32_POS_INF, 0xFFC00000u};
+    for (uint32_t m = 0; m < 15; m++) {
+        cbvh_f32 t[4];
+        for (int c = 0; c < 4; c++) t[c] = ((m >> c) & 1u) ? F_ONE + (uint32_t)c : odd[c];
+        emit_qstack(g, 0, 5, m, t, 0);
+    }
+    static const cbvh_f32 tdist[4] = {0x40400000u, F_ONE, 0x40800000u, 0x40000000u};
+    static const uint32_t masks[] = {0, 1, 3, 7, 15};
+    for (size_t k = 0; k < sizeof masks / sizeof masks[0]; k++)
+        for (uint32_t d = 0; d < 3; d++) emit_qstack(g, 0, CBVH_QSTACK_ID_LIMIT - 1u + d, masks[k], tdist, 0);
 }
 
 /* ---- exact-path cases (docs/vectors.md, "Exact-path cases") ----------------------
