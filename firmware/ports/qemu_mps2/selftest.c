@@ -40,21 +40,34 @@ static uint32_t next(void) {
 
 static uint8_t req[CBVH_FRAME_MAX];
 static uint32_t digest = 2166136261u; /* FNV-1a over every reply word: equal on ARM and on the host */
-static uint32_t in[40 * 32], want[40 * 32];
+static uint32_t in[1024 * 4], want[1024 * 4]; /* a batch's input words and expected outputs */
+
+/* Sends count vectors (words: count * n_in input words) as one RUN frame in
+ * USB-sized chunks; 0 and the decoded reply in *f when exactly one good reply
+ * came back. */
+static int run_frame(const cbvh_unit *u, const cbvh_unit_config *cfg, const cbvh_layout *lay, const uint32_t *words,
+                     unsigned count, uint16_t seq, cbvh_frame *f) {
+    uint8_t *p = req + CBVH_FRAME_HDR;
+    memset(p, 0, 12);
+    p[0] = u->id;
+    p[1] = (uint8_t)cfg->params.quant_bits;
+    cbvh_put16(p + 2, (uint16_t)(int16_t)cfg->params.min_scale);
+    p[4] = (uint8_t)(cfg->enc == CBVH_ENC_RELATIVE);
+    p[5] = (uint8_t)lay->n_in;
+    p[6] = (uint8_t)lay->n_out;
+    cbvh_put16(p + 8, (uint16_t)count);
+    for (unsigned i = 0; i < count * (unsigned)lay->n_in; i++) cbvh_put32(p + 12 + 4 * i, words[i]);
+    size_t n = cbvh_frame_seal(req, CBVH_CMD_RUN, 0, seq, (uint16_t)(12 + 4 * count * (unsigned)lay->n_in));
+    replies = 0;
+    for (size_t off = 0; off < n; off += 64) cbvh_fw_rx(&fw, req + off, n - off < 64 ? n - off : 64);
+    return replies != 1 || cbvh_frame_decode(last, last_len, f) != CBVH_E_OK || f->status != CBVH_E_OK ||
+           f->seq != seq;
+}
 
 static int check_unit(const cbvh_unit *u, int n_bits, int enc, unsigned count, uint16_t seq) {
     cbvh_unit_config cfg = {{n_bits, -30}, enc ? CBVH_ENC_RELATIVE : CBVH_ENC_MODULO};
     cbvh_layout lay;
     u->layout(&cfg, &lay);
-    uint8_t *p = req + CBVH_FRAME_HDR;
-    memset(p, 0, 12);
-    p[0] = u->id;
-    p[1] = (uint8_t)n_bits;
-    cbvh_put16(p + 2, (uint16_t)(int16_t)-30);
-    p[4] = (uint8_t)enc;
-    p[5] = (uint8_t)lay.n_in;
-    p[6] = (uint8_t)lay.n_out;
-    cbvh_put16(p + 8, (uint16_t)count);
     for (unsigned i = 0; i < count * (unsigned)lay.n_in; i++) {
         uint32_t w = next();
         int d = lay.in[i % (unsigned)lay.n_in].hex_digits;
@@ -63,7 +76,6 @@ static int check_unit(const cbvh_unit *u, int n_bits, int enc, unsigned count, u
         else if (d == 1) w &= 3u;
         else if ((w & 3u) != 0) w = 0x3F000000u + (w & 0x00FFFFFFu); /* mostly 0.5..2 */
         in[i] = w;
-        cbvh_put32(p + 12 + 4 * i, w);
     }
     /* Contexts with parent_scale < scale are kept out, so that the runs reach
      * the datapath rather than the reject (BAD_SCALE; the relative node-pair
@@ -79,16 +91,11 @@ static int check_unit(const cbvh_unit *u, int n_bits, int enc, unsigned count, u
                 uint32_t t = w[f];
                 w[f] = w[f + 1];
                 w[f + 1] = t;
-                cbvh_put32(p + 12 + 4 * (v * (unsigned)lay.n_in + (unsigned)f), w[f]);
-                cbvh_put32(p + 12 + 4 * (v * (unsigned)lay.n_in + (unsigned)f + 1), w[f + 1]);
             }
         }
     for (unsigned v = 0; v < count; v++) u->eval(&cfg, in + v * (unsigned)lay.n_in, want + v * (unsigned)lay.n_out);
-    size_t n = cbvh_frame_seal(req, CBVH_CMD_RUN, 0, seq, (uint16_t)(12 + 4 * count * (unsigned)lay.n_in));
-    replies = 0;
-    for (size_t off = 0; off < n; off += 64) cbvh_fw_rx(&fw, req + off, n - off < 64 ? n - off : 64); /* USB-sized chunks */
     cbvh_frame f;
-    if (replies != 1 || cbvh_frame_decode(last, last_len, &f) != CBVH_E_OK || f.status != CBVH_E_OK || f.seq != seq) {
+    if (run_frame(u, &cfg, &lay, in, count, seq, &f)) {
         printf("FAIL %s: no good reply (replies %d, status %d)\n", u->name, replies, last_len > 3 ? last[3] : -1);
         return 1;
     }
@@ -104,26 +111,11 @@ static int check_unit(const cbvh_unit *u, int n_bits, int enc, unsigned count, u
 
 /* ---- golden vectors ---------------------------------------------------------- */
 
-static uint32_t gin[1024 * 4], gwant[1024 * 4];
-
-/* Sends count vectors of one file as one RUN frame; returns mismatching vectors. */
+/* Sends count vectors of one file (in, want) as one RUN frame; returns mismatching vectors. */
 static unsigned golden_batch(const cbvh_unit *u, const cbvh_unit_config *cfg, const cbvh_layout *lay,
                              unsigned count, uint16_t seq, const char *file, unsigned first) {
-    uint8_t *p = req + CBVH_FRAME_HDR;
-    memset(p, 0, 12);
-    p[0] = u->id;
-    p[1] = (uint8_t)cfg->params.quant_bits;
-    cbvh_put16(p + 2, (uint16_t)(int16_t)cfg->params.min_scale);
-    p[4] = (uint8_t)(cfg->enc == CBVH_ENC_RELATIVE);
-    p[5] = (uint8_t)lay->n_in;
-    p[6] = (uint8_t)lay->n_out;
-    cbvh_put16(p + 8, (uint16_t)count);
-    for (unsigned i = 0; i < count * (unsigned)lay->n_in; i++) cbvh_put32(p + 12 + 4 * i, gin[i]);
-    size_t n = cbvh_frame_seal(req, CBVH_CMD_RUN, 0, seq, (uint16_t)(12 + 4 * count * (unsigned)lay->n_in));
-    replies = 0;
-    for (size_t off = 0; off < n; off += 64) cbvh_fw_rx(&fw, req + off, n - off < 64 ? n - off : 64);
     cbvh_frame f;
-    if (replies != 1 || cbvh_frame_decode(last, last_len, &f) != CBVH_E_OK || f.status != CBVH_E_OK || f.seq != seq) {
+    if (run_frame(u, cfg, lay, in, count, seq, &f)) {
         printf("FAIL %s: no good reply to a batch of %u\n", file, count);
         return count;
     }
@@ -131,7 +123,7 @@ static unsigned golden_batch(const cbvh_unit *u, const cbvh_unit_config *cfg, co
     for (unsigned v = 0; v < count; v++)
         for (int k = 0; k < lay->n_out; k++)
             if (cbvh_get32(f.payload + 4 + 4 * (v * (unsigned)lay->n_out + (unsigned)k)) !=
-                gwant[v * (unsigned)lay->n_out + (unsigned)k]) {
+                want[v * (unsigned)lay->n_out + (unsigned)k]) {
                 if (bad++ < 3) printf("FAIL %s: vector %u, output %s differs\n", file, first + v, lay->out[k].name);
                 break;
             }
@@ -165,7 +157,7 @@ static int golden_file(const char *path, const char *name, unsigned *nvec, unsig
                 u->layout(&cfg, &lay);
                 unsigned words = (unsigned)(lay.n_in > lay.n_out ? lay.n_in : lay.n_out);
                 batch = (CBVH_FRAME_MAX_PAYLOAD - 12) / (4 * words);
-                if (batch > sizeof gin / sizeof gin[0] / words) batch = (unsigned)(sizeof gin / sizeof gin[0]) / words;
+                if (batch > sizeof in / sizeof in[0] / words) batch = (unsigned)(sizeof in / sizeof in[0]) / words;
             }
             continue;
         }
@@ -173,8 +165,8 @@ static int golden_file(const char *path, const char *name, unsigned *nvec, unsig
         for (int k = 0; k < lay.n_in + lay.n_out; k++, s = e) {
             unsigned long w = strtoul(s, &e, 16);
             if (e == s) bad_line = 1;
-            if (k < lay.n_in) gin[in_batch * (unsigned)lay.n_in + (unsigned)k] = (uint32_t)w;
-            else gwant[in_batch * (unsigned)lay.n_out + (unsigned)(k - lay.n_in)] = (uint32_t)w;
+            if (k < lay.n_in) in[in_batch * (unsigned)lay.n_in + (unsigned)k] = (uint32_t)w;
+            else want[in_batch * (unsigned)lay.n_out + (unsigned)(k - lay.n_in)] = (uint32_t)w;
         }
         if (bad_line) break;
         if (++in_batch == batch) {
