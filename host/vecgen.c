@@ -1387,6 +1387,54 @@ static void exact_ray_sphere(gen_t *g, rng_t *rng, int count) {
     }
 }
 
+/* ---- reject combinations (generator 3) --------------------------------------
+ *
+ * An input with several faults at once (a NaN bound and a bad scale, a bad
+ * code in an inverted child, ...) gets exactly one reject bit: the first of
+ * the unit's checks in the order docs/datapath.md §10 lists.  Generators 1
+ * and 2 had single faults only, so an implementation that set every bit that
+ * applies passed them (found by the independent RTL in gateware/).  These
+ * cases are every combination of the faults of each axis unit, appended after
+ * the level-1 part with no random draws. */
+
+static void reject_combinations_compress(gen_t *g) {
+    const cbvh_f32 F3 = 0x40400000u; /* 3.0 */
+    static const cbvh_f32 nan = 0x7FC00000u;
+    const cbvh_f32 boxes[][2] = {{F_ONE, F3},         {nan, F3}, {F_ONE, CBVH_F32_POS_INF}, {F3, F_ONE},
+                                 {CBVH_F32_POS_INF, F_ONE}, {F_ONE, CBVH_F32_NEG_INF}, {nan, nan}};
+    const int valid = g->ms <= 0 ? 0 : g->ms;
+    const int scales[] = {valid, g->ms - 1, 127, -128};
+    for (size_t b = 0; b < sizeof boxes / sizeof boxes[0]; b++)
+        for (size_t e = 0; e < sizeof scales / sizeof scales[0]; e++) emit_compress(g, boxes[b][0], boxes[b][1], scales[e]);
+}
+
+static void reject_combinations_decode(gen_t *g) {
+    const uint32_t full = g->mask + 1u;
+    /* A valid context: ms <= scale <= parent_scale <= 126, p^ = 0. */
+    cbvh_axis_ctx base;
+    base.scale = g->ms + 2 > CBVH_SCALE_CEIL ? CBVH_SCALE_CEIL : g->ms + 2;
+    base.parent_scale = base.scale + 2 > CBVH_SCALE_CEIL ? CBVH_SCALE_CEIL : base.scale + 2;
+    base.lb_mod = 0;
+    base.clb = F_ONE;
+    for (int sc = 0; sc < 4; sc++)               /* none, scale < ms, parent_scale > 126, parent_scale < scale */
+        for (int nc = 0; nc < 2; nc++)           /* none, node_lb_mod >= 2^N */
+            for (int cl = 0; cl < 3; cl++)       /* none, clb NaN, clb +Inf */
+                for (int cc = 0; cc < 3; cc++)   /* none, lb_code >= 2^N, ub_code >= 2^N */
+                    for (int inv = 0; inv < 2; inv++) { /* r < s, r >= s */
+                        cbvh_axis_ctx c = base;
+                        if (sc == 1) c.scale = g->ms - 1;
+                        if (sc == 2) c.parent_scale = 127;
+                        if (sc == 3) c.parent_scale = c.scale - 1;
+                        if (nc) c.lb_mod = full;
+                        if (cl == 1) c.clb = 0x7FC00000u;
+                        if (cl == 2) c.clb = CBVH_F32_POS_INF;
+                        uint32_t lc = inv ? 2 : 1, uc = inv ? 1 : 2;
+                        if (cc == 1) lc = full;
+                        if (cc == 2) uc = 0xFFF;
+                        emit_decode(g, &c, lc, uc);
+                    }
+}
+
 /* ---- files ------------------------------------------------------------------- */
 
 /* Vectors of a level-1 file per unit (the committed set stays small). */
@@ -1453,6 +1501,8 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     rng_t ex; /* generator 2: the exact-path cases, from a stream of their own */
     rng_seed(&ex, s->seed ^ h ^ UINT64_C(0xE7AC7CA5E5000002));
     if (exact) exact(&g, &ex, n_exact);
+    if (fn == gen_compress) reject_combinations_compress(&g);
+    if (fn == gen_decode) reject_combinations_decode(&g);
     if (s->level >= 2) {
         g.random_only = 1;
         fn(&g, g.n + CBVH_VECGEN_LEVEL2_RANDOM);

@@ -1,0 +1,72 @@
+// Timing and area harnesses for the iCE40UP5K (gateware/scripts/synth-ice40).
+// A unit's ports are far wider than the 39 I/O pins of the UP5K's sg48
+// package, so each harness feeds the unit's inputs from a shift register on
+// one pin and captures its outputs in a register that shifts out on another.
+// Every output bit stays observable (nothing is optimised away), and the
+// only register-to-register path through the unit is input register ->
+// unit -> output register, so nextpnr's maximum frequency is the unit's.
+`default_nettype none
+
+module fpga_top_scale_estimator #(parameter integer N = 6, parameter integer E_MIN = -30) (
+    input wire clk, input wire din, input wire load, output wire dout);
+    localparam integer IN_W = 64, OUT_W = 8 + 7;
+    reg [IN_W-1:0] in_sr;
+    reg [OUT_W-1:0] out_sr;
+    wire [7:0] scale;
+    wire [6:0] status;
+    cbvh_scale_estimator #(.N(N), .E_MIN(E_MIN)) unit (
+        .lb(in_sr[31:0]), .ub(in_sr[63:32]), .scale(scale), .status(status));
+    always @(posedge clk) begin
+        in_sr <= {in_sr[IN_W-2:0], din};
+        out_sr <= load ? {scale, status} : {1'b0, out_sr[OUT_W-1:1]};
+    end
+    assign dout = out_sr[0];
+endmodule
+
+module fpga_top_axis_compressor #(parameter integer N = 6, parameter integer E_MIN = -30) (
+    input wire clk, input wire din, input wire load, output wire dout);
+    localparam integer IN_W = 72, OUT_W = 2 * N + 8 + 64 + 7;
+    reg [IN_W-1:0] in_sr;
+    reg [OUT_W-1:0] out_sr;
+    wire [N-1:0] lb_mod, ub_mod;
+    wire [7:0] child_scale;
+    wire [31:0] clb, cub;
+    wire [6:0] status;
+    cbvh_axis_compressor #(.N(N), .E_MIN(E_MIN)) unit (
+        .lb(in_sr[31:0]), .ub(in_sr[63:32]), .scale(in_sr[71:64]),
+        .lb_mod(lb_mod), .ub_mod(ub_mod), .child_scale(child_scale),
+        .clb(clb), .cub(cub), .status(status));
+    always @(posedge clk) begin
+        in_sr <= {in_sr[IN_W-2:0], din};
+        out_sr <= load ? {lb_mod, ub_mod, child_scale, clb, cub, status}
+                       : {1'b0, out_sr[OUT_W-1:1]};
+    end
+    assign dout = out_sr[0];
+endmodule
+
+module fpga_top_axis_decoder #(parameter integer N = 6, parameter integer E_MIN = -30,
+                               parameter integer MODULO = 1) (
+    input wire clk, input wire din, input wire load, output wire dout);
+    // Code inputs are 12 bits wide at every N (3 hex digits on the wire; the
+    // unit flags codes >= 2^N).
+    localparam integer IN_W = 8 + 8 + 12 + 32 + 12 + 12, OUT_W = 2 * N + 8 + 64 + 7;
+    reg [IN_W-1:0] in_sr;
+    reg [OUT_W-1:0] out_sr;
+    wire [N-1:0] lb_mod, ub_mod;
+    wire [7:0] child_scale;
+    wire [31:0] clb, cub;
+    wire [6:0] status;
+    cbvh_axis_decoder #(.N(N), .E_MIN(E_MIN), .MODULO(MODULO)) unit (
+        .parent_scale(in_sr[7:0]), .scale(in_sr[15:8]), .node_lb_mod(in_sr[27:16]),
+        .node_clb(in_sr[59:28]), .lb_code(in_sr[71:60]), .ub_code(in_sr[83:72]),
+        .lb_mod(lb_mod), .ub_mod(ub_mod), .child_scale(child_scale),
+        .clb(clb), .cub(cub), .status(status));
+    always @(posedge clk) begin
+        in_sr <= {in_sr[IN_W-2:0], din};
+        out_sr <= load ? {lb_mod, ub_mod, child_scale, clb, cub, status}
+                       : {1'b0, out_sr[OUT_W-1:1]};
+    end
+    assign dout = out_sr[0];
+endmodule
+
+`default_nettype wire
