@@ -1391,7 +1391,8 @@ static void exact_ray_sphere(gen_t *g, rng_t *rng, int count) {
  *
  * An input with several faults at once (a NaN bound and a bad scale, a bad
  * code in an inverted child, ...) gets exactly one reject bit: the first of
- * the unit's checks in the order docs/datapath.md §10 lists.  Generators 1
+ * the unit's checks in the order docs/datapath.md §10 (docs/qbvh.md §2 for
+ * the QBVH stack) lists.  Generators 1
  * and 2 had single faults only, so an implementation that set every bit that
  * applies passed them (found by the independent RTL in gateware/).  These
  * cases are every combination of the faults of each axis unit, appended after
@@ -1433,6 +1434,126 @@ static void reject_combinations_decode(gen_t *g) {
                         if (cc == 2) uc = 0xFFF;
                         emit_decode(g, &c, lc, uc);
                     }
+}
+
+/* QBVH stack: a push with a NaN hit time and a first-child ID >= 2^26 (NAN_INF
+ * wins), an invalid op with both, and pops whose push-only inputs (first,
+ * hit_mask, t) hold those faults: a pop ignores them and never rejects. */
+static void reject_combinations_qstack(gen_t *g) {
+    static const cbvh_f32 nan = 0x7FC00000u;
+    const cbvh_f32 t_nan[4] = {F_ONE, nan, 0x40000000u, nan};
+    const cbvh_f32 t_ok[4] = {F_ONE, 0x40400000u, 0x40000000u, 0x40800000u};
+    static const uint32_t masks[] = {0, 1, 2, 3, 10, 15};
+    static const uint32_t firsts[] = {5, CBVH_QSTACK_ID_LIMIT, 0xFFFFFFFFu};
+    static const uint32_t entries[] = {0x00000005u, 0xE4000007u, 0x03FFFFFFu};
+    for (size_t m = 0; m < sizeof masks / sizeof masks[0]; m++)
+        for (size_t f = 0; f < sizeof firsts / sizeof firsts[0]; f++) {
+            emit_qstack(g, 0, firsts[f], masks[m], t_nan, 0);
+            emit_qstack(g, 0, firsts[f], masks[m], t_nan, entries[f]); /* entry is pop-only */
+            emit_qstack(g, 2, firsts[f], masks[m], t_nan, 0);
+            emit_qstack(g, 15, firsts[f], masks[m], t_ok, 0);
+            emit_qstack(g, 1, firsts[f], masks[m], t_nan, entries[f]);
+            emit_qstack(g, 1, firsts[f], masks[m], t_ok, entries[(f + 1) % 3]);
+        }
+}
+
+/* Node pairs: the status is an OR over the axes and children (datapath.md §9),
+ * so these combine a context rejected on one or several axes (one fault or
+ * two on one axis) with children that are NaN, inverted, too wide for the
+ * grid (NO_FIT), with a pointer wider than its field, empty with a NaN box and
+ * a stray pointer, or with unused flag bits; the decoder gets the encoder's
+ * words for such pairs (and an all-empty pair, a malformed empty marker with a
+ * reserved bit) under the same contexts. */
+static void np_context(gen_t *g, int variant, cbvh_node_ctx *c) {
+    int e = g->ms > -4 ? g->ms : -4;
+    for (int a = 0; a < 3; a++) c->axis[a] = (cbvh_axis_ctx){e, e, 0, 0};
+    if (variant == 1) c->axis[0].scale = g->ms - 1;
+    if (variant == 2) c->axis[0].scale = g->ms - 1, c->axis[0].clb = 0x7FC00000u;
+    if (variant == 3) c->axis[0].scale = g->ms - 1, c->axis[1].clb = 0x7FC00000u, c->axis[2].lb_mod = g->mask + 1u;
+}
+
+static void np_children(gen_t *g, int variant, child_t ch[2]) {
+    const box_t good = {0x3E800000u /* 0.25 */, 0x3F000000u /* 0.5 */};
+    for (int c = 0; c < 2; c++) {
+        for (int a = 0; a < 3; a++) ch[c].b[a] = good;
+        ch[c].flags = (uint32_t)c; /* inner, leaf */
+        ch[c].ptr = 7;
+    }
+    switch (variant) {
+    case 1: ch[0].b[0].lo = 0x7FC00000u, ch[1].b[2].hi = 0x42C80000u /* 100: NO_FIT */; break;
+    case 2: ch[0].b[1] = (box_t){0x40400000u, F_ONE}; break; /* inverted */
+    case 3: ch[0].ptr = ptr_ones(g->N) == 0xFFFFFFFFu ? 0xFFFFFFFFu : ptr_ones(g->N) + 1u, /* inner: too wide */
+            ch[1].b[0].hi = 0x42C80000u;
+            break;
+    case 4: ch[0].flags = 2, ch[0].b[0].lo = 0x7FC00000u, ch[0].ptr = 0xFFFFFFFFu; break; /* empty */
+    case 5: ch[0].flags = 0xD, ch[1].ptr = ptr_ones(g->N); break; /* unused flag bits; leaf at the marker */
+    case 6: ch[0].flags = ch[1].flags = 2; break; /* both empty */
+    default: break;
+    }
+}
+
+static void reject_combinations_nodepair(gen_t *g, int decode) {
+    const cbvh_unit *enc_unit = cbvh_unit_find("nodepair_encode");
+    int nw = (int)cbvh_nodepair_bytes(g->N) / 4;
+    for (int cv = 0; cv < 4; cv++)
+        for (int kv = 0; kv < 7; kv++) {
+            node_t nd;
+            np_context(g, cv, &nd.ctx);
+            child_t ch[2];
+            np_children(g, kv, ch);
+            if (!decode) {
+                emit_encode(g, &nd, ch);
+                continue;
+            }
+            /* the words of the pair under the valid context (zero if rejected) */
+            node_t ok;
+            np_context(g, 0, &ok.ctx);
+            uint32_t in[28], out[8];
+            encode_inputs(&ok, ch, in);
+            enc_unit->eval(&g->spec->cfg, in, out);
+            emit_decode_pair(g, &nd.ctx, out, nw);
+            if (kv == 6) { /* both empty; node 0's marker with a code bit set, the top bit of the pair set
+                            * (reserved where the layout has spare bits) */
+                out[0] |= 1u;
+                out[nw - 1] |= 0x80000000u;
+                emit_decode_pair(g, &nd.ctx, out, nw);
+            }
+        }
+}
+
+/* Ray-box (traversal.md §3: every applicable reject bit is ORed): each
+ * combination of a NaN origin, a zero direction, a bad M, a bad scale, a NaN
+ * plane base and bad codes (r = s; codes >= 2^11, which an 11-bit port would
+ * cut off); then rays whose t_near or t_far is decided by a tmin or tmax of
+ * -0 against a +0 plane distance or one inside the box (the unit's max/min
+ * keep the first of equal values, so -0 can come out). */
+static void reject_combinations_ray_box(gen_t *g) {
+    const cbvh_f32 half = 0x3F000000u, quarter = 0x3E800000u, nan = 0x7FC00000u, pinf = CBVH_F32_POS_INF;
+    static const uint32_t rs[][2] = {{0, 8}, {5, 5}, {0x800, 0x801}, {0xFFF, 0}};
+    for (int k = 0; k < 128; k++) {
+        cbvh_f32 o[3] = {(k & 1) ? nan : half, half, half};
+        cbvh_f32 d[3] = {F_ONE, half, quarter};
+        if (k & 2) d[0] = d[1] = d[2] = 0;
+        int mant = (k & 4) ? 2 : 24;
+        int e[3] = {-3, -3, (k & 8) ? 127 : -3};
+        cbvh_f32 u[3] = {0, (k & 16) ? nan : 0, 0};
+        uint32_t r[3] = {0, 0, rs[(k >> 5) & 3][0]}, sv[3] = {8, 8, rs[(k >> 5) & 3][1]};
+        emit_ray_box(g, o, d, 0, pinf, mant, u, e, r, sv);
+    }
+    const int e[3] = {-3, -3, -3};
+    const cbvh_f32 u[3] = {0, 0, 0};
+    const uint32_t r[3] = {0, 0, 0}, sv[3] = {8, 8, 8}; /* the box [0, 1]^3 */
+    const cbvh_f32 inside[3] = {half, half, half}, on_face[3] = {0, half, half}, far_face[3] = {F_ONE, half, half};
+    const cbvh_f32 dpos[3] = {F_ONE, half, quarter}, dneg[3] = {0xBF800000u, half, quarter};
+    for (int m = 3; m <= 24; m += 21) {
+        emit_ray_box(g, inside, dpos, CBVH_F32_SIGN, pinf, m, u, e, r, sv);   /* t_near = tmin = -0 */
+        emit_ray_box(g, on_face, dpos, CBVH_F32_SIGN, pinf, m, u, e, r, sv);  /* n_x = +0 against tmin -0 */
+        emit_ray_box(g, on_face, dpos, 0, pinf, m, u, e, r, sv);              /* n_x = +0 against tmin +0 */
+        emit_ray_box(g, far_face, dneg, CBVH_F32_SIGN, pinf, m, u, e, r, sv); /* the same from the far face */
+        emit_ray_box(g, on_face, dneg, CBVH_F32_SIGN, CBVH_F32_SIGN, m, u, e, r, sv); /* f_x = +0, tmax -0 */
+        emit_ray_box(g, on_face, dneg, CBVH_F32_SIGN, 0, m, u, e, r, sv);
+        emit_ray_box(g, inside, dpos, CBVH_F32_SIGN, CBVH_F32_SIGN, m, u, e, r, sv); /* empty interval [-0, -0] */
+    }
 }
 
 /* ---- files ------------------------------------------------------------------- */
@@ -1503,6 +1624,10 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     if (exact) exact(&g, &ex, n_exact);
     if (fn == gen_compress) reject_combinations_compress(&g);
     if (fn == gen_decode) reject_combinations_decode(&g);
+    if (fn == gen_qbvh_stack) reject_combinations_qstack(&g);
+    if (fn == gen_ray_box) reject_combinations_ray_box(&g);
+    if (fn == gen_encode_pair) reject_combinations_nodepair(&g, 0);
+    if (fn == gen_decode_pair) reject_combinations_nodepair(&g, 1);
     if (s->level >= 2) {
         g.random_only = 1;
         fn(&g, g.n + CBVH_VECGEN_LEVEL2_RANDOM);

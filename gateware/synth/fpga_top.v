@@ -69,4 +69,49 @@ module fpga_top_axis_decoder #(parameter integer N = 6, parameter integer E_MIN 
     assign dout = out_sr[0];
 endmodule
 
+module fpga_top_qbvh_stack (input wire clk, input wire din, input wire load, output wire dout);
+    localparam integer IN_W = 4 + 32 + 4 + 128 + 32, OUT_W = 32 + 32 + 1 + 8 + 4 + 8;
+    reg [IN_W-1:0] in_sr;
+    reg [OUT_W-1:0] out_sr;
+    wire [31:0] node, next_entry;
+    wire write;
+    wire [7:0] order, status;
+    wire [3:0] nhit;
+    cbvh_qbvh_stack unit (
+        .op(in_sr[3:0]), .first(in_sr[35:4]), .hit_mask(in_sr[39:36]), .t0(in_sr[71:40]),
+        .t1(in_sr[103:72]), .t2(in_sr[135:104]), .t3(in_sr[167:136]), .entry(in_sr[199:168]),
+        .node(node), .next_entry(next_entry), .write(write), .order(order), .nhit(nhit), .status(status));
+    always @(posedge clk) begin
+        in_sr <= {in_sr[IN_W-2:0], din};
+        out_sr <= load ? {node, next_entry, write, order, nhit, status} : {1'b0, out_sr[OUT_W-1:1]};
+    end
+    assign dout = out_sr[0];
+endmodule
+
+// The ray-box unit is sequential (one shared divider): its own registers bound
+// the critical path; start and rst come from pins.
+module fpga_top_ray_box (input wire clk, input wire din, input wire load, input wire start,
+                         input wire rst, output wire dout, output wire busy, output wire done);
+    localparam integer IN_W = 8 * 32 + 8 + 3 * (32 + 8 + 24), OUT_W = 1 + 64 + 8;
+    reg [IN_W-1:0] in_sr;
+    reg [OUT_W-1:0] out_sr;
+    wire hit;
+    wire [31:0] t_near, t_far;
+    wire [7:0] status;
+    cbvh_ray_box unit (
+        .clk(clk), .rst(rst), .start(start), .busy(busy), .done(done),
+        .ox(in_sr[31:0]), .oy(in_sr[63:32]), .oz(in_sr[95:64]), .dx(in_sr[127:96]),
+        .dy(in_sr[159:128]), .dz(in_sr[191:160]), .tmin(in_sr[223:192]), .tmax(in_sr[255:224]),
+        .mant(in_sr[263:256]),
+        .x_u(in_sr[295:264]), .x_scale(in_sr[303:296]), .x_r(in_sr[315:304]), .x_s(in_sr[327:316]),
+        .y_u(in_sr[359:328]), .y_scale(in_sr[367:360]), .y_r(in_sr[379:368]), .y_s(in_sr[391:380]),
+        .z_u(in_sr[423:392]), .z_scale(in_sr[431:424]), .z_r(in_sr[443:432]), .z_s(in_sr[455:444]),
+        .hit(hit), .t_near(t_near), .t_far(t_far), .status(status));
+    always @(posedge clk) begin
+        in_sr <= {in_sr[IN_W-2:0], din};
+        out_sr <= load ? {hit, t_near, t_far, status} : {1'b0, out_sr[OUT_W-1:1]};
+    end
+    assign dout = out_sr[0];
+endmodule
+
 `default_nettype wire

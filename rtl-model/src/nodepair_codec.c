@@ -105,6 +105,11 @@ uint32_t cbvh_nodepair_decode(const cbvh_params *p, cbvh_encoding enc, const cbv
     if (st) return st;
     int w = cbvh_node_bits(n), pb = cbvh_node_ptr_bits(n);
     uint32_t ones = ptr_all_ones(n);
+    /* The context first, as the encoder checks it: a pair of two empty
+     * children runs no axis unit, and must not decode under a context the
+     * encoder rejects (docs/datapath.md §9). */
+    for (int a = 0; a < 3; a++) st |= cbvh_axis_ctx_check(p, &ctx->axis[a]);
+    if (st) return st;
     for (int c = 0; c < 2; c++) {
         const node_bits nb_c = load_node(bytes + (size_t)c * (size_t)w / 8u, w / 8), *node = &nb_c;
         cbvh_child_out *o = &out[c];

@@ -1,0 +1,287 @@
+// Testbench for cbvh_nodepair_decoder (unit 4, decode direction): runs a golden
+// vector file (docs/vectors.md, unit nodepair_decode) given by +vec=PATH. The
+// file's header must match the parameters N, E_MIN and MODULO; every output
+// field is compared. Inputs: the three axis contexts and the pair's words
+// (word0..word3 for N <= 6, word0..word5 for N >= 7).
+//   iverilog -g2005 -P tb_nodepair_decoder.N=6 -P tb_nodepair_decoder.E_MIN=-30 \
+//     -P tb_nodepair_decoder.MODULO=1 -s tb_nodepair_decoder -o tb.vvp \
+//     gateware/tb/tb_nodepair_decoder.v gateware/rtl/*.v \
+//     && vvp tb.vvp +vec=vectors/nodepair_decode-N6-ms-30-modulo.vec
+module tb_nodepair_decoder;
+    parameter integer N      = 6;
+    parameter integer E_MIN  = -30;
+    parameter integer MODULO = 1;
+
+    localparam LINE_BYTES = 640;
+
+    reg  [7:0]    x_parent_scale;
+    reg  [7:0]    x_scale;
+    reg  [11:0]   x_node_lb_mod;
+    reg  [31:0]   x_node_clb;
+    reg  [7:0]    y_parent_scale;
+    reg  [7:0]    y_scale;
+    reg  [11:0]   y_node_lb_mod;
+    reg  [31:0]   y_node_clb;
+    reg  [7:0]    z_parent_scale;
+    reg  [7:0]    z_scale;
+    reg  [11:0]   z_node_lb_mod;
+    reg  [31:0]   z_node_clb;
+    reg  [31:0]  word0, word1, word2, word3, word4, word5;
+    wire [1:0]    c0_flags;
+    wire [31:0]   c0_ptr;
+    wire [N-1:0]  c0_x_lb_mod;
+    wire [N-1:0]  c0_x_ub_mod;
+    wire [7:0]    c0_x_child_scale;
+    wire [31:0]   c0_x_clb;
+    wire [31:0]   c0_x_cub;
+    wire [N-1:0]  c0_y_lb_mod;
+    wire [N-1:0]  c0_y_ub_mod;
+    wire [7:0]    c0_y_child_scale;
+    wire [31:0]   c0_y_clb;
+    wire [31:0]   c0_y_cub;
+    wire [N-1:0]  c0_z_lb_mod;
+    wire [N-1:0]  c0_z_ub_mod;
+    wire [7:0]    c0_z_child_scale;
+    wire [31:0]   c0_z_clb;
+    wire [31:0]   c0_z_cub;
+    wire [1:0]    c1_flags;
+    wire [31:0]   c1_ptr;
+    wire [N-1:0]  c1_x_lb_mod;
+    wire [N-1:0]  c1_x_ub_mod;
+    wire [7:0]    c1_x_child_scale;
+    wire [31:0]   c1_x_clb;
+    wire [31:0]   c1_x_cub;
+    wire [N-1:0]  c1_y_lb_mod;
+    wire [N-1:0]  c1_y_ub_mod;
+    wire [7:0]    c1_y_child_scale;
+    wire [31:0]   c1_y_clb;
+    wire [31:0]   c1_y_cub;
+    wire [N-1:0]  c1_z_lb_mod;
+    wire [N-1:0]  c1_z_ub_mod;
+    wire [7:0]    c1_z_child_scale;
+    wire [31:0]   c1_z_clb;
+    wire [31:0]   c1_z_cub;
+    wire [6:0]    status;
+
+    cbvh_nodepair_decoder #(.N(N), .E_MIN(E_MIN), .MODULO(MODULO)) dut (
+        .x_parent_scale(x_parent_scale), .x_scale(x_scale), .x_node_lb_mod(x_node_lb_mod),
+        .x_node_clb(x_node_clb), .y_parent_scale(y_parent_scale), .y_scale(y_scale),
+        .y_node_lb_mod(y_node_lb_mod), .y_node_clb(y_node_clb),
+        .z_parent_scale(z_parent_scale), .z_scale(z_scale), .z_node_lb_mod(z_node_lb_mod),
+        .z_node_clb(z_node_clb), .word0(word0), .word1(word1), .word2(word2), .word3(word3),
+        .word4(word4), .word5(word5), .c0_flags(c0_flags), .c0_ptr(c0_ptr),
+        .c0_x_lb_mod(c0_x_lb_mod), .c0_x_ub_mod(c0_x_ub_mod),
+        .c0_x_child_scale(c0_x_child_scale), .c0_x_clb(c0_x_clb), .c0_x_cub(c0_x_cub),
+        .c0_y_lb_mod(c0_y_lb_mod), .c0_y_ub_mod(c0_y_ub_mod),
+        .c0_y_child_scale(c0_y_child_scale), .c0_y_clb(c0_y_clb), .c0_y_cub(c0_y_cub),
+        .c0_z_lb_mod(c0_z_lb_mod), .c0_z_ub_mod(c0_z_ub_mod),
+        .c0_z_child_scale(c0_z_child_scale), .c0_z_clb(c0_z_clb), .c0_z_cub(c0_z_cub),
+        .c1_flags(c1_flags), .c1_ptr(c1_ptr), .c1_x_lb_mod(c1_x_lb_mod),
+        .c1_x_ub_mod(c1_x_ub_mod), .c1_x_child_scale(c1_x_child_scale), .c1_x_clb(c1_x_clb),
+        .c1_x_cub(c1_x_cub), .c1_y_lb_mod(c1_y_lb_mod), .c1_y_ub_mod(c1_y_ub_mod),
+        .c1_y_child_scale(c1_y_child_scale), .c1_y_clb(c1_y_clb), .c1_y_cub(c1_y_cub),
+        .c1_z_lb_mod(c1_z_lb_mod), .c1_z_ub_mod(c1_z_ub_mod),
+        .c1_z_child_scale(c1_z_child_scale), .c1_z_clb(c1_z_clb), .c1_z_cub(c1_z_cub),
+        .status(status));
+
+    reg [8*1024-1:0]         path;
+    reg [8*LINE_BYTES-1:0]   line;
+    reg [8*64-1:0]           sval;
+    integer fd, rc, lineno, nvec, nfail, count, ival, nf;
+    integer seen_unit, seen_bits, seen_ms, seen_enc, seen_count, in_header;
+    reg bad;
+    // fields as read (file fields can be wider than the ports: compare as read)
+    reg [31:0] i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb, i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb, i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb;
+    reg [31:0] i_word0, i_word1, i_word2, i_word3, i_word4, i_word5;
+    reg [31:0] e_c0_flags, e_c0_ptr, e_c0_x_lb_mod, e_c0_x_ub_mod, e_c0_x_child_scale, e_c0_x_clb;
+    reg [31:0] e_c0_x_cub, e_c0_y_lb_mod, e_c0_y_ub_mod, e_c0_y_child_scale, e_c0_y_clb, e_c0_y_cub;
+    reg [31:0] e_c0_z_lb_mod, e_c0_z_ub_mod, e_c0_z_child_scale, e_c0_z_clb, e_c0_z_cub, e_c1_flags;
+    reg [31:0] e_c1_ptr, e_c1_x_lb_mod, e_c1_x_ub_mod, e_c1_x_child_scale, e_c1_x_clb, e_c1_x_cub;
+    reg [31:0] e_c1_y_lb_mod, e_c1_y_ub_mod, e_c1_y_child_scale, e_c1_y_clb, e_c1_y_cub, e_c1_z_lb_mod;
+    reg [31:0] e_c1_z_ub_mod, e_c1_z_child_scale, e_c1_z_clb, e_c1_z_cub, e_status;
+
+    task read_line;
+        begin
+            line = {8*LINE_BYTES{1'b0}};
+            rc = $fgets(line, fd);
+            lineno = lineno + 1;
+        end
+    endtask
+
+    // one output field: got (zero-extended port) against expected (as read)
+    task check;
+        input [8*20-1:0] name;
+        input [31:0] got;
+        input [31:0] exp;
+        begin
+            if (got !== exp) begin
+                if (!bad) begin
+                    nfail = nfail + 1;
+                    if (nfail <= 10)
+                        $display("mismatch line %0d: inputs %02h %02h %03h %08h %02h %02h %03h %08h %02h %02h %03h %08h words %08h %08h %08h %08h %08h %08h",
+                                 lineno, i_x_parent_scale[7:0], i_x_scale[7:0], i_x_node_lb_mod[11:0], i_x_node_clb,
+                                 i_y_parent_scale[7:0], i_y_scale[7:0], i_y_node_lb_mod[11:0], i_y_node_clb,
+                                 i_z_parent_scale[7:0], i_z_scale[7:0], i_z_node_lb_mod[11:0], i_z_node_clb,
+                                 i_word0, i_word1, i_word2, i_word3, i_word4, i_word5);
+                end
+                bad = 1'b1;
+                if (nfail <= 10)
+                    $display("  %0s expected %08h got %08h", name, exp, got);
+            end
+        end
+    endtask
+
+    initial begin
+        if (!$value$plusargs("vec=%s", path))
+            $fatal(1, "tb_nodepair_decoder: no vector file given (+vec=PATH)");
+        fd = $fopen(path, "r");
+        if (fd == 0)
+            $fatal(1, "tb_nodepair_decoder: cannot open vector file %0s", path);
+        lineno = 0; nvec = 0; nfail = 0; count = -1;
+        seen_unit = 0; seen_bits = 0; seen_ms = 0; seen_enc = 0; seen_count = 0;
+
+        read_line;
+        if (line != {"# cbvh golden vectors", 8'h0A})
+            $fatal(1, "tb_nodepair_decoder: %0s:1: not a cbvh vector file", path);
+
+        // header: key: value lines until ---
+        in_header = 1;
+        while (in_header) begin
+            read_line;
+            if (rc == 0)
+                $fatal(1, "tb_nodepair_decoder: %0s: no '---' line", path);
+            if (line == {"---", 8'h0A}) begin
+                in_header = 0;
+            end else begin
+                sval = 0;
+                if ($sscanf(line, "unit: %s", sval) == 1) begin
+                    seen_unit = 1;
+                    if (sval != "nodepair_decode")
+                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: unit %0s, expected nodepair_decode",
+                               path, lineno, sval);
+                end else if ($sscanf(line, "quant_bits: %d", ival) == 1) begin
+                    seen_bits = 1;
+                    if (ival != N)
+                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: quant_bits %0d but N = %0d",
+                               path, lineno, ival, N);
+                end else if ($sscanf(line, "min_scale: %d", ival) == 1) begin
+                    seen_ms = 1;
+                    if (ival != E_MIN)
+                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: min_scale %0d but E_MIN = %0d",
+                               path, lineno, ival, E_MIN);
+                end else if ($sscanf(line, "encoding: %s", sval) == 1) begin
+                    seen_enc = 1;
+                    if (!((sval == "modulo" && MODULO != 0) || (sval == "relative" && MODULO == 0)))
+                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: encoding %0s but MODULO = %0d",
+                               path, lineno, sval, MODULO);
+                end else if ($sscanf(line, "count: %d", ival) == 1) begin
+                    seen_count = 1;
+                    count = ival;
+                end
+            end
+        end
+        if (!(seen_unit && seen_bits && seen_ms && seen_enc && seen_count))
+            $fatal(1, "tb_nodepair_decoder: %0s: header lacks unit, quant_bits, min_scale, encoding or count",
+                   path);
+
+        // vectors: 12 context fields, 4 (N <= 6) or 6 (N >= 7) words, 35 outputs
+        read_line;
+        while (rc != 0) begin
+            i_word4 = 0; i_word5 = 0;
+            if (N <= 6)
+                nf = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
+                            i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb,
+                            i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb,
+                            i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb, i_word0,
+                            i_word1, i_word2, i_word3, e_c0_flags, e_c0_ptr, e_c0_x_lb_mod,
+                            e_c0_x_ub_mod, e_c0_x_child_scale, e_c0_x_clb, e_c0_x_cub,
+                            e_c0_y_lb_mod, e_c0_y_ub_mod, e_c0_y_child_scale, e_c0_y_clb,
+                            e_c0_y_cub, e_c0_z_lb_mod, e_c0_z_ub_mod, e_c0_z_child_scale,
+                            e_c0_z_clb, e_c0_z_cub, e_c1_flags, e_c1_ptr, e_c1_x_lb_mod,
+                            e_c1_x_ub_mod, e_c1_x_child_scale, e_c1_x_clb, e_c1_x_cub,
+                            e_c1_y_lb_mod, e_c1_y_ub_mod, e_c1_y_child_scale, e_c1_y_clb,
+                            e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod, e_c1_z_child_scale,
+                            e_c1_z_clb, e_c1_z_cub, e_status) - 51;
+            else
+                nf = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
+                            i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb,
+                            i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb,
+                            i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb, i_word0,
+                            i_word1, i_word2, i_word3, i_word4, i_word5, e_c0_flags, e_c0_ptr,
+                            e_c0_x_lb_mod, e_c0_x_ub_mod, e_c0_x_child_scale, e_c0_x_clb,
+                            e_c0_x_cub, e_c0_y_lb_mod, e_c0_y_ub_mod, e_c0_y_child_scale,
+                            e_c0_y_clb, e_c0_y_cub, e_c0_z_lb_mod, e_c0_z_ub_mod,
+                            e_c0_z_child_scale, e_c0_z_clb, e_c0_z_cub, e_c1_flags, e_c1_ptr,
+                            e_c1_x_lb_mod, e_c1_x_ub_mod, e_c1_x_child_scale, e_c1_x_clb,
+                            e_c1_x_cub, e_c1_y_lb_mod, e_c1_y_ub_mod, e_c1_y_child_scale,
+                            e_c1_y_clb, e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod,
+                            e_c1_z_child_scale, e_c1_z_clb, e_c1_z_cub, e_status) - 53;
+            if (nf != 0)
+                $fatal(1, "tb_nodepair_decoder: %0s:%0d: malformed vector line", path, lineno);
+            x_parent_scale   = i_x_parent_scale[7:0];
+            x_scale          = i_x_scale[7:0];
+            x_node_lb_mod    = i_x_node_lb_mod[11:0];
+            x_node_clb       = i_x_node_clb[31:0];
+            y_parent_scale   = i_y_parent_scale[7:0];
+            y_scale          = i_y_scale[7:0];
+            y_node_lb_mod    = i_y_node_lb_mod[11:0];
+            y_node_clb       = i_y_node_clb[31:0];
+            z_parent_scale   = i_z_parent_scale[7:0];
+            z_scale          = i_z_scale[7:0];
+            z_node_lb_mod    = i_z_node_lb_mod[11:0];
+            z_node_clb       = i_z_node_clb[31:0];
+            word0            = i_word0;
+            word1            = i_word1;
+            word2            = i_word2;
+            word3            = i_word3;
+            word4            = i_word4;
+            word5            = i_word5;
+            #1;
+            nvec = nvec + 1;
+            bad = 1'b0;
+            check("c0_flags", {30'd0, c0_flags}, e_c0_flags);
+            check("c0_ptr", c0_ptr, e_c0_ptr);
+            check("c0_x_lb_mod", {{(32 - N){1'b0}}, c0_x_lb_mod}, e_c0_x_lb_mod);
+            check("c0_x_ub_mod", {{(32 - N){1'b0}}, c0_x_ub_mod}, e_c0_x_ub_mod);
+            check("c0_x_child_scale", {24'd0, c0_x_child_scale}, e_c0_x_child_scale);
+            check("c0_x_clb", c0_x_clb, e_c0_x_clb);
+            check("c0_x_cub", c0_x_cub, e_c0_x_cub);
+            check("c0_y_lb_mod", {{(32 - N){1'b0}}, c0_y_lb_mod}, e_c0_y_lb_mod);
+            check("c0_y_ub_mod", {{(32 - N){1'b0}}, c0_y_ub_mod}, e_c0_y_ub_mod);
+            check("c0_y_child_scale", {24'd0, c0_y_child_scale}, e_c0_y_child_scale);
+            check("c0_y_clb", c0_y_clb, e_c0_y_clb);
+            check("c0_y_cub", c0_y_cub, e_c0_y_cub);
+            check("c0_z_lb_mod", {{(32 - N){1'b0}}, c0_z_lb_mod}, e_c0_z_lb_mod);
+            check("c0_z_ub_mod", {{(32 - N){1'b0}}, c0_z_ub_mod}, e_c0_z_ub_mod);
+            check("c0_z_child_scale", {24'd0, c0_z_child_scale}, e_c0_z_child_scale);
+            check("c0_z_clb", c0_z_clb, e_c0_z_clb);
+            check("c0_z_cub", c0_z_cub, e_c0_z_cub);
+            check("c1_flags", {30'd0, c1_flags}, e_c1_flags);
+            check("c1_ptr", c1_ptr, e_c1_ptr);
+            check("c1_x_lb_mod", {{(32 - N){1'b0}}, c1_x_lb_mod}, e_c1_x_lb_mod);
+            check("c1_x_ub_mod", {{(32 - N){1'b0}}, c1_x_ub_mod}, e_c1_x_ub_mod);
+            check("c1_x_child_scale", {24'd0, c1_x_child_scale}, e_c1_x_child_scale);
+            check("c1_x_clb", c1_x_clb, e_c1_x_clb);
+            check("c1_x_cub", c1_x_cub, e_c1_x_cub);
+            check("c1_y_lb_mod", {{(32 - N){1'b0}}, c1_y_lb_mod}, e_c1_y_lb_mod);
+            check("c1_y_ub_mod", {{(32 - N){1'b0}}, c1_y_ub_mod}, e_c1_y_ub_mod);
+            check("c1_y_child_scale", {24'd0, c1_y_child_scale}, e_c1_y_child_scale);
+            check("c1_y_clb", c1_y_clb, e_c1_y_clb);
+            check("c1_y_cub", c1_y_cub, e_c1_y_cub);
+            check("c1_z_lb_mod", {{(32 - N){1'b0}}, c1_z_lb_mod}, e_c1_z_lb_mod);
+            check("c1_z_ub_mod", {{(32 - N){1'b0}}, c1_z_ub_mod}, e_c1_z_ub_mod);
+            check("c1_z_child_scale", {24'd0, c1_z_child_scale}, e_c1_z_child_scale);
+            check("c1_z_clb", c1_z_clb, e_c1_z_clb);
+            check("c1_z_cub", c1_z_cub, e_c1_z_cub);
+            check("status", {25'd0, status}, e_status);
+            read_line;
+        end
+        $fclose(fd);
+
+        $display("tb_nodepair_decoder: %0s: %0d vectors, %0d failures", path, nvec, nfail);
+        if (nfail > 0 || nvec == 0 || nvec != count)
+            $fatal(1, "tb_nodepair_decoder: FAILED (%0d failures, %0d vectors, header count %0d)",
+                   nfail, nvec, count);
+        $finish;
+    end
+endmodule

@@ -1,0 +1,238 @@
+// Testbench for cbvh_nodepair_encoder: runs a golden vector file (docs/vectors.md).
+//   iverilog -g2005 -P tb_nodepair_encoder.N=6 -P tb_nodepair_encoder.E_MIN=-30 \
+//       -P tb_nodepair_encoder.MODULO=1 -s tb_nodepair_encoder -o tb \
+//       gateware/tb/tb_nodepair_encoder.v gateware/rtl/*.v
+//   vvp tb +vec=vectors/nodepair_encode-N6-ms-30-modulo.vec
+module tb_nodepair_encoder;
+    parameter integer N      = 6;
+    parameter integer E_MIN  = -30;
+    parameter integer MODULO = 1;
+
+    localparam integer LW  = 8 * 512;                // line buffer, bits
+    localparam integer NWO = (N <= 6) ? 4 : 6;       // output words in the file
+    localparam integer NIN = 28;                     // input fields
+
+    reg  [7:0] x_parent_scale;
+    reg  [7:0] x_scale;
+    reg  [11:0] x_node_lb_mod;
+    reg  [31:0] x_node_clb;
+    reg  [7:0] y_parent_scale;
+    reg  [7:0] y_scale;
+    reg  [11:0] y_node_lb_mod;
+    reg  [31:0] y_node_clb;
+    reg  [7:0] z_parent_scale;
+    reg  [7:0] z_scale;
+    reg  [11:0] z_node_lb_mod;
+    reg  [31:0] z_node_clb;
+    reg  [31:0] c0_lo_x;
+    reg  [31:0] c0_hi_x;
+    reg  [31:0] c0_lo_y;
+    reg  [31:0] c0_hi_y;
+    reg  [31:0] c0_lo_z;
+    reg  [31:0] c0_hi_z;
+    reg  [3:0] c0_flags;
+    reg  [31:0] c0_ptr;
+    reg  [31:0] c1_lo_x;
+    reg  [31:0] c1_hi_x;
+    reg  [31:0] c1_lo_y;
+    reg  [31:0] c1_hi_y;
+    reg  [31:0] c1_lo_z;
+    reg  [31:0] c1_hi_z;
+    reg  [3:0] c1_flags;
+    reg  [31:0] c1_ptr;
+    wire [31:0] word0, word1, word2, word3, word4, word5;
+    wire [7:0]  status;
+
+    cbvh_nodepair_encoder #(.N(N), .E_MIN(E_MIN), .MODULO(MODULO)) dut (
+        .x_parent_scale(x_parent_scale),
+        .x_scale(x_scale),
+        .x_node_lb_mod(x_node_lb_mod),
+        .x_node_clb(x_node_clb),
+        .y_parent_scale(y_parent_scale),
+        .y_scale(y_scale),
+        .y_node_lb_mod(y_node_lb_mod),
+        .y_node_clb(y_node_clb),
+        .z_parent_scale(z_parent_scale),
+        .z_scale(z_scale),
+        .z_node_lb_mod(z_node_lb_mod),
+        .z_node_clb(z_node_clb),
+        .c0_lo_x(c0_lo_x),
+        .c0_hi_x(c0_hi_x),
+        .c0_lo_y(c0_lo_y),
+        .c0_hi_y(c0_hi_y),
+        .c0_lo_z(c0_lo_z),
+        .c0_hi_z(c0_hi_z),
+        .c0_flags(c0_flags),
+        .c0_ptr(c0_ptr),
+        .c1_lo_x(c1_lo_x),
+        .c1_hi_x(c1_hi_x),
+        .c1_lo_y(c1_lo_y),
+        .c1_hi_y(c1_hi_y),
+        .c1_lo_z(c1_lo_z),
+        .c1_hi_z(c1_hi_z),
+        .c1_flags(c1_flags),
+        .c1_ptr(c1_ptr),
+        .word0(word0), .word1(word1), .word2(word2), .word3(word3),
+        .word4(word4), .word5(word5), .status(status));
+
+    reg [8*1024-1:0] path;
+    reg [LW-1:0]     line;
+    reg [LW-1:0]     key, val, extra;
+    reg [31:0]       v [0:35];                       // the fields of one vector line
+    reg [31:0]       got [0:5];
+    integer fd, rc, lineno, nvec, nfail, count, qbits, mscale, j, bad;
+    integer have_unit, have_q, have_m, have_enc, have_count, in_header;
+
+    // read one line into 'line' (zero-padded); returns chars read, 0 at EOF
+    task read_line(output integer n);
+        begin
+            line = {LW{1'b0}};
+            n = $fgets(line, fd);
+            lineno = lineno + 1;
+        end
+    endtask
+
+    initial begin
+        if (!$value$plusargs("vec=%s", path))
+            $fatal(1, "tb_nodepair_encoder: missing +vec=PATH");
+        fd = $fopen(path, "r");
+        if (fd == 0)
+            $fatal(1, "tb_nodepair_encoder: cannot open vector file %0s", path);
+        lineno = 0; nvec = 0; nfail = 0; count = -1;
+        have_unit = 0; have_q = 0; have_m = 0; have_enc = 0; have_count = 0;
+
+        read_line(rc);
+        if (rc == 0 || line != "# cbvh golden vectors\n")
+            $fatal(1, "tb_nodepair_encoder: %0s:1: not a cbvh vector file", path);
+
+        // header: key: value lines up to ---
+        in_header = 1;
+        while (in_header) begin
+            read_line(rc);
+            if (rc == 0)
+                $fatal(1, "tb_nodepair_encoder: %0s: no '---' line", path);
+            if (line == "---\n") begin
+                in_header = 0;
+            end else begin
+                key = {LW{1'b0}}; val = {LW{1'b0}};
+                rc = $sscanf(line, "%s %s", key, val);
+                if (key == "unit:") begin
+                    have_unit = 1;
+                    if (val != "nodepair_encode")
+                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: unit is '%0s', expected nodepair_encode",
+                               path, lineno, val);
+                end else if (key == "quant_bits:") begin
+                    have_q = 1;
+                    rc = $sscanf(line, "quant_bits: %d", qbits);
+                    if (rc != 1 || qbits != N)
+                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: quant_bits %0d but the testbench has N=%0d",
+                               path, lineno, qbits, N);
+                end else if (key == "min_scale:") begin
+                    have_m = 1;
+                    rc = $sscanf(line, "min_scale: %d", mscale);
+                    if (rc != 1 || mscale != E_MIN)
+                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: min_scale %0d but the testbench has E_MIN=%0d",
+                               path, lineno, mscale, E_MIN);
+                end else if (key == "encoding:") begin
+                    have_enc = 1;
+                    if (!((val == "modulo" && MODULO == 1) || (val == "relative" && MODULO == 0)))
+                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: encoding '%0s' but the testbench has MODULO=%0d",
+                               path, lineno, val, MODULO);
+                end else if (key == "count:") begin
+                    have_count = 1;
+                    rc = $sscanf(line, "count: %d", count);
+                    if (rc != 1 || count < 0)
+                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: bad count", path, lineno);
+                end
+            end
+        end
+        if (!have_unit || !have_q || !have_m || !have_enc || !have_count)
+            $fatal(1, "tb_nodepair_encoder: %0s: header lacks unit, quant_bits, min_scale, encoding or count",
+                   path);
+
+        // vectors: 28 input fields, then NWO words and status
+        read_line(rc);
+        while (rc != 0) begin
+            // NIN + NWO + 1 hex fields (inputs, words, status); 'extra' catches one more
+            extra = {LW{1'b0}};
+            for (j = 0; j < 36; j = j + 1) v[j] = 32'd0;
+            if (NWO == 4)
+                rc = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
+                             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
+                             v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15],
+                             v[16], v[17], v[18], v[19], v[20], v[21], v[22], v[23],
+                             v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31],
+                             v[32], extra);
+            else
+                rc = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
+                             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
+                             v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15],
+                             v[16], v[17], v[18], v[19], v[20], v[21], v[22], v[23],
+                             v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31],
+                             v[32], v[33], v[34], extra);
+            if (rc != NIN + NWO + 1)
+                $fatal(1, "tb_nodepair_encoder: %0s:%0d: malformed vector line (%0d fields)", path, lineno, rc);
+            x_parent_scale = v[0][7:0];
+            x_scale = v[1][7:0];
+            x_node_lb_mod = v[2][11:0];
+            x_node_clb = v[3][31:0];
+            y_parent_scale = v[4][7:0];
+            y_scale = v[5][7:0];
+            y_node_lb_mod = v[6][11:0];
+            y_node_clb = v[7][31:0];
+            z_parent_scale = v[8][7:0];
+            z_scale = v[9][7:0];
+            z_node_lb_mod = v[10][11:0];
+            z_node_clb = v[11][31:0];
+            c0_lo_x = v[12][31:0];
+            c0_hi_x = v[13][31:0];
+            c0_lo_y = v[14][31:0];
+            c0_hi_y = v[15][31:0];
+            c0_lo_z = v[16][31:0];
+            c0_hi_z = v[17][31:0];
+            c0_flags = v[18][3:0];
+            c0_ptr = v[19][31:0];
+            c1_lo_x = v[20][31:0];
+            c1_hi_x = v[21][31:0];
+            c1_lo_y = v[22][31:0];
+            c1_hi_y = v[23][31:0];
+            c1_lo_z = v[24][31:0];
+            c1_hi_z = v[25][31:0];
+            c1_flags = v[26][3:0];
+            c1_ptr = v[27][31:0];
+            #1;
+            nvec = nvec + 1;
+            got[0] = word0; got[1] = word1; got[2] = word2;
+            got[3] = word3; got[4] = word4; got[5] = word5;
+            bad = 0;
+            for (j = 0; j < 6; j = j + 1)
+                if (j < NWO) begin
+                    if (got[j] !== v[NIN + j]) bad = 1;
+                end else begin
+                    if (got[j] !== 32'd0) bad = 1;   // unused words must stay zero
+                end
+            if (v[NIN + NWO] !== {24'd0, status}) bad = 1;
+            if (bad) begin
+                nfail = nfail + 1;
+                if (nfail <= 10) begin
+                    $display("mismatch line %0d: inputs %02h %02h %03h %08h %02h %02h %03h %08h %02h %02h %03h %08h %08h %08h %08h %08h %08h %08h %01h %08h %08h %08h %08h %08h %08h %08h %01h %08h",
+                             lineno, v[0][7:0], v[1][7:0], v[2][11:0], v[3][31:0], v[4][7:0], v[5][7:0], v[6][11:0], v[7][31:0], v[8][7:0], v[9][7:0], v[10][11:0], v[11][31:0], v[12][31:0], v[13][31:0], v[14][31:0], v[15][31:0], v[16][31:0], v[17][31:0], v[18][3:0], v[19][31:0], v[20][31:0], v[21][31:0], v[22][31:0], v[23][31:0], v[24][31:0], v[25][31:0], v[26][3:0], v[27][31:0]);
+                    $display("    expected words %08h %08h %08h %08h %08h %08h status %02h",
+                             v[NIN], v[NIN + 1], v[NIN + 2], v[NIN + 3],
+                             (NWO == 6) ? v[NIN + 4] : 32'd0, (NWO == 6) ? v[NIN + 5] : 32'd0,
+                             v[NIN + NWO][7:0]);
+                    $display("    got      words %08h %08h %08h %08h %08h %08h status %02h",
+                             word0, word1, word2, word3, word4, word5, status);
+                end
+            end
+            read_line(rc);
+        end
+        $fclose(fd);
+
+        $display("tb_nodepair_encoder: %0s: %0d vectors, %0d failures", path, nvec, nfail);
+        if (nfail > 0 || nvec == 0 || nvec != count)
+            $fatal(1, "tb_nodepair_encoder: FAIL (%0d failures, %0d vectors, header count %0d)",
+                   nfail, nvec, count);
+        $finish;
+    end
+endmodule

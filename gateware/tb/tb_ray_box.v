@@ -1,0 +1,159 @@
+// Testbench for cbvh_ray_box (unit 6): runs a golden vector file
+// (docs/vectors.md, unit ray_box) given by +vec=PATH. The unit depends on
+// neither N nor e_min; the parameters are only checked against the header.
+// Every vector: drive the inputs, pulse start, wait for done (at most
+// MAX_CYCLES clocks), compare hit, t_near, t_far and status.
+//   iverilog -g2005 -P tb_ray_box.N=6 -P tb_ray_box.E_MIN=-30 -s tb_ray_box \
+//     -o tb.vvp gateware/tb/tb_ray_box.v gateware/rtl/ray_box.v &&
+//     vvp tb.vvp +vec=vectors/ray_box-N6-ms-30.vec
+module tb_ray_box;
+    parameter integer N     = 6;
+    parameter integer E_MIN = -30;
+
+    localparam LINE_BYTES = 512;
+    localparam integer MAX_CYCLES = 2000;
+
+    reg clk = 1'b0;
+    reg rst = 1'b1;
+    reg start = 1'b0;
+    wire busy, done;
+    reg  [31:0] ox, oy, oz, dx, dy, dz, tmin, tmax;
+    reg  [7:0]  mant;
+    reg  [31:0] x_u, y_u, z_u;
+    reg  [7:0]  x_scale, y_scale, z_scale;
+    reg  [11:0] x_r, x_s, y_r, y_s, z_r, z_s;
+    wire        hit;
+    wire [31:0] t_near, t_far;
+    wire [7:0]  status;
+
+    cbvh_ray_box dut (
+        .clk(clk), .rst(rst), .start(start), .busy(busy), .done(done),
+        .ox(ox), .oy(oy), .oz(oz), .dx(dx), .dy(dy), .dz(dz),
+        .tmin(tmin), .tmax(tmax), .mant(mant),
+        .x_u(x_u), .x_scale(x_scale), .x_r(x_r), .x_s(x_s),
+        .y_u(y_u), .y_scale(y_scale), .y_r(y_r), .y_s(y_s),
+        .z_u(z_u), .z_scale(z_scale), .z_r(z_r), .z_s(z_s),
+        .hit(hit), .t_near(t_near), .t_far(t_far), .status(status));
+
+    always #5 clk = ~clk;
+
+    reg [8*1024-1:0]         path;
+    reg [8*LINE_BYTES-1:0]   line;
+    reg [8*64-1:0]           sval;
+    integer fd, rc, lineno, nvec, nfail, count, ival, cyc;
+    integer cyc_min, cyc_max, cyc_sum, cyc_int;
+    integer seen_unit, seen_bits, seen_ms, seen_count, in_header;
+    reg [31:0] i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant;
+    reg [31:0] i_xu, i_xe, i_xr, i_xs, i_yu, i_ye, i_yr, i_ys, i_zu, i_ze, i_zr, i_zs;
+    reg [31:0] x_hit, x_tn, x_tf, x_status;
+
+    task read_line;
+        begin
+            line = {8*LINE_BYTES{1'b0}};
+            rc = $fgets(line, fd);
+            lineno = lineno + 1;
+        end
+    endtask
+
+    initial begin
+        if (!$value$plusargs("vec=%s", path))
+            $fatal(1, "tb_ray_box: no vector file given (+vec=PATH)");
+        fd = $fopen(path, "r");
+        if (fd == 0)
+            $fatal(1, "tb_ray_box: cannot open vector file %0s", path);
+        lineno = 0; nvec = 0; nfail = 0; count = -1;
+        cyc_min = 0; cyc_max = 0; cyc_sum = 0;
+        seen_unit = 0; seen_bits = 0; seen_ms = 0; seen_count = 0;
+
+        read_line;
+        if (line != {"# cbvh golden vectors", 8'h0A})
+            $fatal(1, "tb_ray_box: %0s:1: not a cbvh vector file", path);
+
+        in_header = 1;
+        while (in_header) begin
+            read_line;
+            if (rc == 0)
+                $fatal(1, "tb_ray_box: %0s: no '---' line", path);
+            if (line == {"---", 8'h0A}) begin
+                in_header = 0;
+            end else begin
+                sval = 0;
+                if ($sscanf(line, "unit: %s", sval) == 1) begin
+                    seen_unit = 1;
+                    if (sval != "ray_box")
+                        $fatal(1, "tb_ray_box: %0s:%0d: unit %0s, expected ray_box",
+                               path, lineno, sval);
+                end else if ($sscanf(line, "quant_bits: %d", ival) == 1) begin
+                    seen_bits = 1;
+                    if (ival != N)
+                        $fatal(1, "tb_ray_box: %0s:%0d: quant_bits %0d but N = %0d",
+                               path, lineno, ival, N);
+                end else if ($sscanf(line, "min_scale: %d", ival) == 1) begin
+                    seen_ms = 1;
+                    if (ival != E_MIN)
+                        $fatal(1, "tb_ray_box: %0s:%0d: min_scale %0d but E_MIN = %0d",
+                               path, lineno, ival, E_MIN);
+                end else if ($sscanf(line, "count: %d", ival) == 1) begin
+                    seen_count = 1;
+                    count = ival;
+                end
+            end
+        end
+        if (!(seen_unit && seen_bits && seen_ms && seen_count))
+            $fatal(1, "tb_ray_box: %0s: header lacks unit, quant_bits, min_scale or count", path);
+
+        // reset
+        repeat (2) @(posedge clk);
+        #1 rst = 1'b0;
+
+        read_line;
+        while (rc != 0) begin
+            if ($sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
+                        i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant,
+                        i_xu, i_xe, i_xr, i_xs, i_yu, i_ye, i_yr, i_ys, i_zu, i_ze, i_zr, i_zs,
+                        x_hit, x_tn, x_tf, x_status) != 25)
+                $fatal(1, "tb_ray_box: %0s:%0d: malformed vector line", path, lineno);
+            ox = i_ox; oy = i_oy; oz = i_oz; dx = i_dx; dy = i_dy; dz = i_dz;
+            tmin = i_tmin; tmax = i_tmax; mant = i_mant[7:0];
+            x_u = i_xu; x_scale = i_xe[7:0]; x_r = i_xr[11:0]; x_s = i_xs[11:0];
+            y_u = i_yu; y_scale = i_ye[7:0]; y_r = i_yr[11:0]; y_s = i_ys[11:0];
+            z_u = i_zu; z_scale = i_ze[7:0]; z_r = i_zr[11:0]; z_s = i_zs[11:0];
+            start = 1'b1;
+            @(posedge clk);
+            #1 start = 1'b0;
+            cyc = 1;
+            while (!done) begin
+                if (cyc >= MAX_CYCLES)
+                    $fatal(1, "tb_ray_box: %0s:%0d: no done after %0d cycles", path, lineno, cyc);
+                @(posedge clk);
+                #1 cyc = cyc + 1;
+            end
+            cyc_int = cyc;
+            if (nvec == 0 || cyc_int < cyc_min) cyc_min = cyc_int;
+            if (cyc_int > cyc_max) cyc_max = cyc_int;
+            cyc_sum = cyc_sum + cyc_int;
+            nvec = nvec + 1;
+            if ({31'd0, hit} !== x_hit || t_near !== x_tn || t_far !== x_tf ||
+                {24'd0, status} !== x_status) begin
+                nfail = nfail + 1;
+                if (nfail <= 10)
+                    $display("mismatch line %0d: inputs %08h %08h %08h %08h %08h %08h %08h %08h %02h %08h %02h %03h %03h %08h %02h %03h %03h %08h %02h %03h %03h expected %01h %08h %08h %02h got %01h %08h %08h %02h",
+                             lineno, i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant[7:0],
+                             i_xu, i_xe[7:0], i_xr[11:0], i_xs[11:0], i_yu, i_ye[7:0], i_yr[11:0], i_ys[11:0],
+                             i_zu, i_ze[7:0], i_zr[11:0], i_zs[11:0],
+                             x_hit[3:0], x_tn, x_tf, x_status[7:0], hit, t_near, t_far, status);
+            end
+            read_line;
+        end
+        $fclose(fd);
+
+        if (nvec > 0)
+            $display("tb_ray_box: cycles per vector (start to done): min %0d, avg %0d, max %0d",
+                     cyc_min, cyc_sum / nvec, cyc_max);
+        $display("tb_ray_box: %0s: %0d vectors, %0d failures", path, nvec, nfail);
+        if (nfail > 0 || nvec == 0 || nvec != count)
+            $fatal(1, "tb_ray_box: FAILED (%0d failures, %0d vectors, header count %0d)",
+                   nfail, nvec, count);
+        $finish;
+    end
+endmodule
