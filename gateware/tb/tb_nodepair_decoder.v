@@ -12,7 +12,6 @@ module tb_nodepair_decoder;
     parameter integer E_MIN  = -30;
     parameter integer MODULO = 1;
 
-    localparam LINE_BYTES = 640;
 
     reg  [7:0]    x_parent_scale;
     reg  [7:0]    x_scale;
@@ -84,11 +83,11 @@ module tb_nodepair_decoder;
         .c1_z_child_scale(c1_z_child_scale), .c1_z_clb(c1_z_clb), .c1_z_cub(c1_z_cub),
         .status(status));
 
-    reg [8*1024-1:0]         path;
-    reg [8*LINE_BYTES-1:0]   line;
-    reg [8*64-1:0]           sval;
-    integer fd, rc, lineno, nvec, nfail, count, ival, nf;
-    integer seen_unit, seen_bits, seen_ms, seen_enc, seen_count, in_header;
+    localparam [8*24-1:0] VF_TB = "tb_nodepair_decoder", VF_UNIT = "nodepair_decode";
+    localparam integer VF_ENC = 1, VF_MODULO = MODULO;
+    `include "vecfile.vh"
+
+    integer nf;
     reg bad;
     // fields as read (file fields can be wider than the ports: compare as read)
     reg [31:0] i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb, i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb, i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb;
@@ -100,14 +99,6 @@ module tb_nodepair_decoder;
     reg [31:0] e_c1_y_lb_mod, e_c1_y_ub_mod, e_c1_y_child_scale, e_c1_y_clb, e_c1_y_cub, e_c1_z_lb_mod;
     reg [31:0] e_c1_z_ub_mod, e_c1_z_child_scale, e_c1_z_clb, e_c1_z_cub, e_status;
 
-    task read_line;
-        begin
-            line = {8*LINE_BYTES{1'b0}};
-            rc = $fgets(line, fd);
-            lineno = lineno + 1;
-        end
-    endtask
-
     // one output field: got (zero-extended port) against expected (as read)
     task check;
         input [8*20-1:0] name;
@@ -116,80 +107,30 @@ module tb_nodepair_decoder;
         begin
             if (got !== exp) begin
                 if (!bad) begin
-                    nfail = nfail + 1;
-                    if (nfail <= 10)
+                    vf_nfail = vf_nfail + 1;
+                    if (vf_nfail <= 10)
                         $display("mismatch line %0d: inputs %02h %02h %03h %08h %02h %02h %03h %08h %02h %02h %03h %08h words %08h %08h %08h %08h %08h %08h",
-                                 lineno, i_x_parent_scale[7:0], i_x_scale[7:0], i_x_node_lb_mod[11:0], i_x_node_clb,
+                                 vf_lineno, i_x_parent_scale[7:0], i_x_scale[7:0], i_x_node_lb_mod[11:0], i_x_node_clb,
                                  i_y_parent_scale[7:0], i_y_scale[7:0], i_y_node_lb_mod[11:0], i_y_node_clb,
                                  i_z_parent_scale[7:0], i_z_scale[7:0], i_z_node_lb_mod[11:0], i_z_node_clb,
                                  i_word0, i_word1, i_word2, i_word3, i_word4, i_word5);
                 end
                 bad = 1'b1;
-                if (nfail <= 10)
+                if (vf_nfail <= 10)
                     $display("  %0s expected %08h got %08h", name, exp, got);
             end
         end
     endtask
 
     initial begin
-        if (!$value$plusargs("vec=%s", path))
-            $fatal(1, "tb_nodepair_decoder: no vector file given (+vec=PATH)");
-        fd = $fopen(path, "r");
-        if (fd == 0)
-            $fatal(1, "tb_nodepair_decoder: cannot open vector file %0s", path);
-        lineno = 0; nvec = 0; nfail = 0; count = -1;
-        seen_unit = 0; seen_bits = 0; seen_ms = 0; seen_enc = 0; seen_count = 0;
-
-        read_line;
-        if (line != {"# cbvh golden vectors", 8'h0A})
-            $fatal(1, "tb_nodepair_decoder: %0s:1: not a cbvh vector file", path);
-
-        // header: key: value lines until ---
-        in_header = 1;
-        while (in_header) begin
-            read_line;
-            if (rc == 0)
-                $fatal(1, "tb_nodepair_decoder: %0s: no '---' line", path);
-            if (line == {"---", 8'h0A}) begin
-                in_header = 0;
-            end else begin
-                sval = 0;
-                if ($sscanf(line, "unit: %s", sval) == 1) begin
-                    seen_unit = 1;
-                    if (sval != "nodepair_decode")
-                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: unit %0s, expected nodepair_decode",
-                               path, lineno, sval);
-                end else if ($sscanf(line, "quant_bits: %d", ival) == 1) begin
-                    seen_bits = 1;
-                    if (ival != N)
-                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: quant_bits %0d but N = %0d",
-                               path, lineno, ival, N);
-                end else if ($sscanf(line, "min_scale: %d", ival) == 1) begin
-                    seen_ms = 1;
-                    if (ival != E_MIN)
-                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: min_scale %0d but E_MIN = %0d",
-                               path, lineno, ival, E_MIN);
-                end else if ($sscanf(line, "encoding: %s", sval) == 1) begin
-                    seen_enc = 1;
-                    if (!((sval == "modulo" && MODULO != 0) || (sval == "relative" && MODULO == 0)))
-                        $fatal(1, "tb_nodepair_decoder: %0s:%0d: encoding %0s but MODULO = %0d",
-                               path, lineno, sval, MODULO);
-                end else if ($sscanf(line, "count: %d", ival) == 1) begin
-                    seen_count = 1;
-                    count = ival;
-                end
-            end
-        end
-        if (!(seen_unit && seen_bits && seen_ms && seen_enc && seen_count))
-            $fatal(1, "tb_nodepair_decoder: %0s: header lacks unit, quant_bits, min_scale, encoding or count",
-                   path);
+        vf_open;
 
         // vectors: 12 context fields, 4 (N <= 6) or 6 (N >= 7) words, 35 outputs
-        read_line;
-        while (rc != 0) begin
+        vf_read_line;
+        while (vf_rc != 0) begin
             i_word4 = 0; i_word5 = 0;
             if (N <= 6)
-                nf = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
+                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
                             i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb,
                             i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb,
                             i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb, i_word0,
@@ -203,7 +144,7 @@ module tb_nodepair_decoder;
                             e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod, e_c1_z_child_scale,
                             e_c1_z_clb, e_c1_z_cub, e_status) - 51;
             else
-                nf = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
+                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
                             i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb,
                             i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb,
                             i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb, i_word0,
@@ -217,7 +158,7 @@ module tb_nodepair_decoder;
                             e_c1_y_clb, e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod,
                             e_c1_z_child_scale, e_c1_z_clb, e_c1_z_cub, e_status) - 53;
             if (nf != 0)
-                $fatal(1, "tb_nodepair_decoder: %0s:%0d: malformed vector line", path, lineno);
+                $fatal(1, "tb_nodepair_decoder: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             x_parent_scale   = i_x_parent_scale[7:0];
             x_scale          = i_x_scale[7:0];
             x_node_lb_mod    = i_x_node_lb_mod[11:0];
@@ -237,7 +178,7 @@ module tb_nodepair_decoder;
             word4            = i_word4;
             word5            = i_word5;
             #1;
-            nvec = nvec + 1;
+            vf_nvec = vf_nvec + 1;
             bad = 1'b0;
             check("c0_flags", {30'd0, c0_flags}, e_c0_flags);
             check("c0_ptr", c0_ptr, e_c0_ptr);
@@ -274,14 +215,8 @@ module tb_nodepair_decoder;
             check("c1_z_clb", c1_z_clb, e_c1_z_clb);
             check("c1_z_cub", c1_z_cub, e_c1_z_cub);
             check("status", {25'd0, status}, e_status);
-            read_line;
+            vf_read_line;
         end
-        $fclose(fd);
-
-        $display("tb_nodepair_decoder: %0s: %0d vectors, %0d failures", path, nvec, nfail);
-        if (nfail > 0 || nvec == 0 || nvec != count)
-            $fatal(1, "tb_nodepair_decoder: FAILED (%0d failures, %0d vectors, header count %0d)",
-                   nfail, nvec, count);
-        $finish;
+        vf_finish;
     end
 endmodule

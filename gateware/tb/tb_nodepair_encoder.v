@@ -75,103 +75,40 @@ module tb_nodepair_encoder;
         .word0(word0), .word1(word1), .word2(word2), .word3(word3),
         .word4(word4), .word5(word5), .status(status));
 
-    reg [8*1024-1:0] path;
-    reg [LW-1:0]     line;
-    reg [LW-1:0]     key, val, extra;
+    localparam [8*24-1:0] VF_TB = "tb_nodepair_encoder", VF_UNIT = "nodepair_encode";
+    localparam integer VF_ENC = 1, VF_MODULO = MODULO;
+    `include "vecfile.vh"
+
+    reg [LW-1:0]     extra;
     reg [31:0]       v [0:35];                       // the fields of one vector line
     reg [31:0]       got [0:5];
-    integer fd, rc, lineno, nvec, nfail, count, qbits, mscale, j, bad;
-    integer have_unit, have_q, have_m, have_enc, have_count, in_header;
-
-    // read one line into 'line' (zero-padded); returns chars read, 0 at EOF
-    task read_line(output integer n);
-        begin
-            line = {LW{1'b0}};
-            n = $fgets(line, fd);
-            lineno = lineno + 1;
-        end
-    endtask
+    integer nf, j, bad;
 
     initial begin
-        if (!$value$plusargs("vec=%s", path))
-            $fatal(1, "tb_nodepair_encoder: missing +vec=PATH");
-        fd = $fopen(path, "r");
-        if (fd == 0)
-            $fatal(1, "tb_nodepair_encoder: cannot open vector file %0s", path);
-        lineno = 0; nvec = 0; nfail = 0; count = -1;
-        have_unit = 0; have_q = 0; have_m = 0; have_enc = 0; have_count = 0;
-
-        read_line(rc);
-        if (rc == 0 || line != "# cbvh golden vectors\n")
-            $fatal(1, "tb_nodepair_encoder: %0s:1: not a cbvh vector file", path);
-
-        // header: key: value lines up to ---
-        in_header = 1;
-        while (in_header) begin
-            read_line(rc);
-            if (rc == 0)
-                $fatal(1, "tb_nodepair_encoder: %0s: no '---' line", path);
-            if (line == "---\n") begin
-                in_header = 0;
-            end else begin
-                key = {LW{1'b0}}; val = {LW{1'b0}};
-                rc = $sscanf(line, "%s %s", key, val);
-                if (key == "unit:") begin
-                    have_unit = 1;
-                    if (val != "nodepair_encode")
-                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: unit is '%0s', expected nodepair_encode",
-                               path, lineno, val);
-                end else if (key == "quant_bits:") begin
-                    have_q = 1;
-                    rc = $sscanf(line, "quant_bits: %d", qbits);
-                    if (rc != 1 || qbits != N)
-                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: quant_bits %0d but the testbench has N=%0d",
-                               path, lineno, qbits, N);
-                end else if (key == "min_scale:") begin
-                    have_m = 1;
-                    rc = $sscanf(line, "min_scale: %d", mscale);
-                    if (rc != 1 || mscale != E_MIN)
-                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: min_scale %0d but the testbench has E_MIN=%0d",
-                               path, lineno, mscale, E_MIN);
-                end else if (key == "encoding:") begin
-                    have_enc = 1;
-                    if (!((val == "modulo" && MODULO == 1) || (val == "relative" && MODULO == 0)))
-                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: encoding '%0s' but the testbench has MODULO=%0d",
-                               path, lineno, val, MODULO);
-                end else if (key == "count:") begin
-                    have_count = 1;
-                    rc = $sscanf(line, "count: %d", count);
-                    if (rc != 1 || count < 0)
-                        $fatal(1, "tb_nodepair_encoder: %0s:%0d: bad count", path, lineno);
-                end
-            end
-        end
-        if (!have_unit || !have_q || !have_m || !have_enc || !have_count)
-            $fatal(1, "tb_nodepair_encoder: %0s: header lacks unit, quant_bits, min_scale, encoding or count",
-                   path);
+        vf_open;
 
         // vectors: 28 input fields, then NWO words and status
-        read_line(rc);
-        while (rc != 0) begin
+        vf_read_line;
+        while (vf_rc != 0) begin
             // NIN + NWO + 1 hex fields (inputs, words, status); 'extra' catches one more
             extra = {LW{1'b0}};
             for (j = 0; j < 36; j = j + 1) v[j] = 32'd0;
             if (NWO == 4)
-                rc = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
+                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
                              v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
                              v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15],
                              v[16], v[17], v[18], v[19], v[20], v[21], v[22], v[23],
                              v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31],
                              v[32], extra);
             else
-                rc = $sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
+                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
                              v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
                              v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15],
                              v[16], v[17], v[18], v[19], v[20], v[21], v[22], v[23],
                              v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31],
                              v[32], v[33], v[34], extra);
-            if (rc != NIN + NWO + 1)
-                $fatal(1, "tb_nodepair_encoder: %0s:%0d: malformed vector line (%0d fields)", path, lineno, rc);
+            if (nf != NIN + NWO + 1)
+                $fatal(1, "tb_nodepair_encoder: %0s:%0d: malformed vector line (%0d fields)", vf_path, vf_lineno, nf);
             x_parent_scale = v[0][7:0];
             x_scale = v[1][7:0];
             x_node_lb_mod = v[2][11:0];
@@ -201,7 +138,7 @@ module tb_nodepair_encoder;
             c1_flags = v[26][3:0];
             c1_ptr = v[27][31:0];
             #1;
-            nvec = nvec + 1;
+            vf_nvec = vf_nvec + 1;
             got[0] = word0; got[1] = word1; got[2] = word2;
             got[3] = word3; got[4] = word4; got[5] = word5;
             bad = 0;
@@ -213,10 +150,10 @@ module tb_nodepair_encoder;
                 end
             if (v[NIN + NWO] !== {24'd0, status}) bad = 1;
             if (bad) begin
-                nfail = nfail + 1;
-                if (nfail <= 10) begin
+                vf_nfail = vf_nfail + 1;
+                if (vf_nfail <= 10) begin
                     $display("mismatch line %0d: inputs %02h %02h %03h %08h %02h %02h %03h %08h %02h %02h %03h %08h %08h %08h %08h %08h %08h %08h %01h %08h %08h %08h %08h %08h %08h %08h %01h %08h",
-                             lineno, v[0][7:0], v[1][7:0], v[2][11:0], v[3][31:0], v[4][7:0], v[5][7:0], v[6][11:0], v[7][31:0], v[8][7:0], v[9][7:0], v[10][11:0], v[11][31:0], v[12][31:0], v[13][31:0], v[14][31:0], v[15][31:0], v[16][31:0], v[17][31:0], v[18][3:0], v[19][31:0], v[20][31:0], v[21][31:0], v[22][31:0], v[23][31:0], v[24][31:0], v[25][31:0], v[26][3:0], v[27][31:0]);
+                             vf_lineno, v[0][7:0], v[1][7:0], v[2][11:0], v[3][31:0], v[4][7:0], v[5][7:0], v[6][11:0], v[7][31:0], v[8][7:0], v[9][7:0], v[10][11:0], v[11][31:0], v[12][31:0], v[13][31:0], v[14][31:0], v[15][31:0], v[16][31:0], v[17][31:0], v[18][3:0], v[19][31:0], v[20][31:0], v[21][31:0], v[22][31:0], v[23][31:0], v[24][31:0], v[25][31:0], v[26][3:0], v[27][31:0]);
                     $display("    expected words %08h %08h %08h %08h %08h %08h status %02h",
                              v[NIN], v[NIN + 1], v[NIN + 2], v[NIN + 3],
                              (NWO == 6) ? v[NIN + 4] : 32'd0, (NWO == 6) ? v[NIN + 5] : 32'd0,
@@ -225,14 +162,8 @@ module tb_nodepair_encoder;
                              word0, word1, word2, word3, word4, word5, status);
                 end
             end
-            read_line(rc);
+            vf_read_line;
         end
-        $fclose(fd);
-
-        $display("tb_nodepair_encoder: %0s: %0d vectors, %0d failures", path, nvec, nfail);
-        if (nfail > 0 || nvec == 0 || nvec != count)
-            $fatal(1, "tb_nodepair_encoder: FAIL (%0d failures, %0d vectors, header count %0d)",
-                   nfail, nvec, count);
-        $finish;
+        vf_finish;
     end
 endmodule

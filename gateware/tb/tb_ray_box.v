@@ -10,7 +10,6 @@ module tb_ray_box;
     parameter integer N     = 6;
     parameter integer E_MIN = -30;
 
-    localparam LINE_BYTES = 512;
     localparam integer MAX_CYCLES = 2000;
 
     reg clk = 1'b0;
@@ -37,82 +36,30 @@ module tb_ray_box;
 
     always #5 clk = ~clk;
 
-    reg [8*1024-1:0]         path;
-    reg [8*LINE_BYTES-1:0]   line;
-    reg [8*64-1:0]           sval;
-    integer fd, rc, lineno, nvec, nfail, count, ival, cyc;
-    integer cyc_min, cyc_max, cyc_sum, cyc_int;
-    integer seen_unit, seen_bits, seen_ms, seen_count, in_header;
+    localparam [8*24-1:0] VF_TB = "tb_ray_box", VF_UNIT = "ray_box";
+    localparam integer VF_ENC = 0, VF_MODULO = 0;
+    `include "vecfile.vh"
+
+    integer cyc, cyc_min, cyc_max, cyc_sum, cyc_int;
     reg [31:0] i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant;
     reg [31:0] i_xu, i_xe, i_xr, i_xs, i_yu, i_ye, i_yr, i_ys, i_zu, i_ze, i_zr, i_zs;
     reg [31:0] x_hit, x_tn, x_tf, x_status;
 
-    task read_line;
-        begin
-            line = {8*LINE_BYTES{1'b0}};
-            rc = $fgets(line, fd);
-            lineno = lineno + 1;
-        end
-    endtask
-
     initial begin
-        if (!$value$plusargs("vec=%s", path))
-            $fatal(1, "tb_ray_box: no vector file given (+vec=PATH)");
-        fd = $fopen(path, "r");
-        if (fd == 0)
-            $fatal(1, "tb_ray_box: cannot open vector file %0s", path);
-        lineno = 0; nvec = 0; nfail = 0; count = -1;
+        vf_open;
         cyc_min = 0; cyc_max = 0; cyc_sum = 0;
-        seen_unit = 0; seen_bits = 0; seen_ms = 0; seen_count = 0;
-
-        read_line;
-        if (line != {"# cbvh golden vectors", 8'h0A})
-            $fatal(1, "tb_ray_box: %0s:1: not a cbvh vector file", path);
-
-        in_header = 1;
-        while (in_header) begin
-            read_line;
-            if (rc == 0)
-                $fatal(1, "tb_ray_box: %0s: no '---' line", path);
-            if (line == {"---", 8'h0A}) begin
-                in_header = 0;
-            end else begin
-                sval = 0;
-                if ($sscanf(line, "unit: %s", sval) == 1) begin
-                    seen_unit = 1;
-                    if (sval != "ray_box")
-                        $fatal(1, "tb_ray_box: %0s:%0d: unit %0s, expected ray_box",
-                               path, lineno, sval);
-                end else if ($sscanf(line, "quant_bits: %d", ival) == 1) begin
-                    seen_bits = 1;
-                    if (ival != N)
-                        $fatal(1, "tb_ray_box: %0s:%0d: quant_bits %0d but N = %0d",
-                               path, lineno, ival, N);
-                end else if ($sscanf(line, "min_scale: %d", ival) == 1) begin
-                    seen_ms = 1;
-                    if (ival != E_MIN)
-                        $fatal(1, "tb_ray_box: %0s:%0d: min_scale %0d but E_MIN = %0d",
-                               path, lineno, ival, E_MIN);
-                end else if ($sscanf(line, "count: %d", ival) == 1) begin
-                    seen_count = 1;
-                    count = ival;
-                end
-            end
-        end
-        if (!(seen_unit && seen_bits && seen_ms && seen_count))
-            $fatal(1, "tb_ray_box: %0s: header lacks unit, quant_bits, min_scale or count", path);
 
         // reset
         repeat (2) @(posedge clk);
         #1 rst = 1'b0;
 
-        read_line;
-        while (rc != 0) begin
-            if ($sscanf(line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
+        vf_read_line;
+        while (vf_rc != 0) begin
+            if ($sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
                         i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant,
                         i_xu, i_xe, i_xr, i_xs, i_yu, i_ye, i_yr, i_ys, i_zu, i_ze, i_zr, i_zs,
                         x_hit, x_tn, x_tf, x_status) != 25)
-                $fatal(1, "tb_ray_box: %0s:%0d: malformed vector line", path, lineno);
+                $fatal(1, "tb_ray_box: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             ox = i_ox; oy = i_oy; oz = i_oz; dx = i_dx; dy = i_dy; dz = i_dz;
             tmin = i_tmin; tmax = i_tmax; mant = i_mant[7:0];
             x_u = i_xu; x_scale = i_xe[7:0]; x_r = i_xr[11:0]; x_s = i_xs[11:0];
@@ -124,36 +71,31 @@ module tb_ray_box;
             cyc = 1;
             while (!done) begin
                 if (cyc >= MAX_CYCLES)
-                    $fatal(1, "tb_ray_box: %0s:%0d: no done after %0d cycles", path, lineno, cyc);
+                    $fatal(1, "tb_ray_box: %0s:%0d: no done after %0d cycles", vf_path, vf_lineno, cyc);
                 @(posedge clk);
                 #1 cyc = cyc + 1;
             end
             cyc_int = cyc;
-            if (nvec == 0 || cyc_int < cyc_min) cyc_min = cyc_int;
+            if (vf_nvec == 0 || cyc_int < cyc_min) cyc_min = cyc_int;
             if (cyc_int > cyc_max) cyc_max = cyc_int;
             cyc_sum = cyc_sum + cyc_int;
-            nvec = nvec + 1;
+            vf_nvec = vf_nvec + 1;
             if ({31'd0, hit} !== x_hit || t_near !== x_tn || t_far !== x_tf ||
                 {24'd0, status} !== x_status) begin
-                nfail = nfail + 1;
-                if (nfail <= 10)
+                vf_nfail = vf_nfail + 1;
+                if (vf_nfail <= 10)
                     $display("mismatch line %0d: inputs %08h %08h %08h %08h %08h %08h %08h %08h %02h %08h %02h %03h %03h %08h %02h %03h %03h %08h %02h %03h %03h expected %01h %08h %08h %02h got %01h %08h %08h %02h",
-                             lineno, i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant[7:0],
+                             vf_lineno, i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant[7:0],
                              i_xu, i_xe[7:0], i_xr[11:0], i_xs[11:0], i_yu, i_ye[7:0], i_yr[11:0], i_ys[11:0],
                              i_zu, i_ze[7:0], i_zr[11:0], i_zs[11:0],
                              x_hit[3:0], x_tn, x_tf, x_status[7:0], hit, t_near, t_far, status);
             end
-            read_line;
+            vf_read_line;
         end
-        $fclose(fd);
 
-        if (nvec > 0)
+        if (vf_nvec > 0)
             $display("tb_ray_box: cycles per vector (start to done): min %0d, avg %0d, max %0d",
-                     cyc_min, cyc_sum / nvec, cyc_max);
-        $display("tb_ray_box: %0s: %0d vectors, %0d failures", path, nvec, nfail);
-        if (nfail > 0 || nvec == 0 || nvec != count)
-            $fatal(1, "tb_ray_box: FAILED (%0d failures, %0d vectors, header count %0d)",
-                   nfail, nvec, count);
-        $finish;
+                     cyc_min, cyc_sum / vf_nvec, cyc_max);
+        vf_finish;
     end
 endmodule
