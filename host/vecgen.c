@@ -1556,6 +1556,35 @@ static void reject_combinations_ray_box(gen_t *g) {
     }
 }
 
+/* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
+ * ray-sphere (§10.2: BAD_PARAM ORed with NAN_INF or ZERO_DIR, ZERO_DIR only for
+ * a ray without NaN/Inf): every combination of a NaN or Inf in the ray, a zero
+ * direction (also -0 components) and a bad vertex, centre or radius. */
+static void reject_combinations_ray_tri(gen_t *g) {
+    const cbvh_f32 nan = 0x7FC00000u, pinf = CBVH_F32_POS_INF;
+    for (int k = 0; k < 16; k++) {
+        cbvh_f32 o[3] = {(k & 1) ? nan : 0x3E800000u, 0x3E800000u, 0xBF800000u};
+        cbvh_f32 d[3] = {0, 0, F_ONE};
+        if (k & 2) d[2] = (k & 8) ? CBVH_F32_SIGN : 0; /* (0, 0, +-0) */
+        cbvh_f32 v[9] = {0, 0, 0, F_ONE, 0, 0, 0, F_ONE, 0};
+        if (k & 4) v[4] = (k & 8) ? pinf : nan;
+        if ((k & 8) && !(k & 2)) d[0] = pinf; /* an Inf direction component */
+        emit_ray_tri(g, o, d, v);
+    }
+}
+
+static void reject_combinations_ray_sphere(gen_t *g) {
+    const cbvh_f32 nan = 0x7FC00000u, pinf = CBVH_F32_POS_INF;
+    for (int k = 0; k < 32; k++) {
+        cbvh_f32 o[3] = {(k & 1) ? nan : 0, 0, 0xC0000000u /* -2 */};
+        cbvh_f32 d[3] = {0, 0, (k & 2) ? CBVH_F32_SIGN : F_ONE};
+        cbvh_f32 tmin = (k & 16) ? pinf : 0, tmax = pinf;
+        cbvh_f32 c[3] = {0, (k & 4) ? nan : 0, 0};
+        cbvh_f32 r = (k & 8) ? 0xBF800000u /* -1 */ : F_ONE;
+        emit_ray_sphere(g, o, d, tmin, tmax, c, r);
+    }
+}
+
 /* ---- files ------------------------------------------------------------------- */
 
 /* Vectors of a level-1 file per unit (the committed set stays small). */
@@ -1626,6 +1655,8 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     if (fn == gen_decode) reject_combinations_decode(&g);
     if (fn == gen_qbvh_stack) reject_combinations_qstack(&g);
     if (fn == gen_ray_box) reject_combinations_ray_box(&g);
+    if (fn == gen_ray_triangle) reject_combinations_ray_tri(&g);
+    if (fn == gen_ray_sphere) reject_combinations_ray_sphere(&g);
     if (fn == gen_encode_pair) reject_combinations_nodepair(&g, 0);
     if (fn == gen_decode_pair) reject_combinations_nodepair(&g, 1);
     if (s->level >= 2) {
