@@ -80,6 +80,7 @@ static cbvh_f32 pat_mag(int i) {
 
 #define F_NEG_0_4 0xBECCCCCDu /* -0.4f: the cloth plane */
 #define F_ONE 0x3F800000u
+#define F_QNAN 0x7FC00000u
 #define F_TWO40 0x53800000u /* 2^40 */
 #define F_TWO24 0x4B800000u /* 2^24 */
 /* A handful of values whose pairs make boxes (incl. straddling zero). */
@@ -1389,20 +1390,20 @@ static void exact_ray_sphere(gen_t *g, rng_t *rng, int count) {
 
 /* ---- reject combinations (generator 3) --------------------------------------
  *
- * An input with several faults at once (a NaN bound and a bad scale, a bad
- * code in an inverted child, ...) gets exactly one reject bit: the first of
- * the unit's checks in the order docs/datapath.md §10 (docs/qbvh.md §2 for
- * the QBVH stack) lists.  Generators 1
- * and 2 had single faults only, so an implementation that set every bit that
- * applies passed them (found by the independent RTL in gateware/).  These
- * cases are every combination of the faults of each axis unit, appended after
- * the level-1 part with no random draws. */
+ * Which status bits an input with several faults at once gets (a NaN bound
+ * and a bad scale, a bad code in an inverted child, ...) is each unit's own
+ * rule: one bit from an order of checks for the axis units, the QBVH stack
+ * and the triangle unit, an OR with stated exceptions for the node pairs, the
+ * ray-box and the sphere unit (datapath.md §9-§10, traversal.md §3, §4,
+ * §10.2, qbvh.md §2).  Generators 1 and 2 had (almost) single faults only,
+ * so independent RTL that chose other rules passed them (docs/gateware.md).
+ * These cases combine each unit's faults; they are appended after the
+ * level-1 part, with no random draws. */
 
 static void reject_combinations_compress(gen_t *g) {
     const cbvh_f32 F3 = 0x40400000u; /* 3.0 */
-    static const cbvh_f32 nan = 0x7FC00000u;
-    const cbvh_f32 boxes[][2] = {{F_ONE, F3},         {nan, F3}, {F_ONE, CBVH_F32_POS_INF}, {F3, F_ONE},
-                                 {CBVH_F32_POS_INF, F_ONE}, {F_ONE, CBVH_F32_NEG_INF}, {nan, nan}};
+    const cbvh_f32 boxes[][2] = {{F_ONE, F3},         {F_QNAN, F3}, {F_ONE, CBVH_F32_POS_INF}, {F3, F_ONE},
+                                 {CBVH_F32_POS_INF, F_ONE}, {F_ONE, CBVH_F32_NEG_INF}, {F_QNAN, F_QNAN}};
     const int valid = g->ms <= 0 ? 0 : g->ms;
     const int scales[] = {valid, g->ms - 1, 127, -128};
     for (size_t b = 0; b < sizeof boxes / sizeof boxes[0]; b++)
@@ -1427,7 +1428,7 @@ static void reject_combinations_decode(gen_t *g) {
                         if (sc == 2) c.parent_scale = 127;
                         if (sc == 3) c.parent_scale = c.scale - 1;
                         if (nc) c.lb_mod = full;
-                        if (cl == 1) c.clb = 0x7FC00000u;
+                        if (cl == 1) c.clb = F_QNAN;
                         if (cl == 2) c.clb = CBVH_F32_POS_INF;
                         uint32_t lc = inv ? 2 : 1, uc = inv ? 1 : 2;
                         if (cc == 1) lc = full;
@@ -1440,8 +1441,7 @@ static void reject_combinations_decode(gen_t *g) {
  * wins), an invalid op with both, and pops whose push-only inputs (first,
  * hit_mask, t) hold those faults: a pop ignores them and never rejects. */
 static void reject_combinations_qstack(gen_t *g) {
-    static const cbvh_f32 nan = 0x7FC00000u;
-    const cbvh_f32 t_nan[4] = {F_ONE, nan, 0x40000000u, nan};
+    const cbvh_f32 t_nan[4] = {F_ONE, F_QNAN, 0x40000000u, F_QNAN};
     const cbvh_f32 t_ok[4] = {F_ONE, 0x40400000u, 0x40000000u, 0x40800000u};
     static const uint32_t masks[] = {0, 1, 2, 3, 10, 15};
     static const uint32_t firsts[] = {5, CBVH_QSTACK_ID_LIMIT, 0xFFFFFFFFu};
@@ -1468,8 +1468,8 @@ static void np_context(gen_t *g, int variant, cbvh_node_ctx *c) {
     int e = g->ms > -4 ? g->ms : -4;
     for (int a = 0; a < 3; a++) c->axis[a] = (cbvh_axis_ctx){e, e, 0, 0};
     if (variant == 1) c->axis[0].scale = g->ms - 1;
-    if (variant == 2) c->axis[0].scale = g->ms - 1, c->axis[0].clb = 0x7FC00000u;
-    if (variant == 3) c->axis[0].scale = g->ms - 1, c->axis[1].clb = 0x7FC00000u, c->axis[2].lb_mod = g->mask + 1u;
+    if (variant == 2) c->axis[0].scale = g->ms - 1, c->axis[0].clb = F_QNAN;
+    if (variant == 3) c->axis[0].scale = g->ms - 1, c->axis[1].clb = F_QNAN, c->axis[2].lb_mod = g->mask + 1u;
 }
 
 static void np_children(gen_t *g, int variant, child_t ch[2]) {
@@ -1480,12 +1480,12 @@ static void np_children(gen_t *g, int variant, child_t ch[2]) {
         ch[c].ptr = 7;
     }
     switch (variant) {
-    case 1: ch[0].b[0].lo = 0x7FC00000u, ch[1].b[2].hi = 0x42C80000u /* 100: NO_FIT */; break;
+    case 1: ch[0].b[0].lo = F_QNAN, ch[1].b[2].hi = 0x42C80000u /* 100: NO_FIT */; break;
     case 2: ch[0].b[1] = (box_t){0x40400000u, F_ONE}; break; /* inverted */
     case 3: ch[0].ptr = ptr_ones(g->N) == 0xFFFFFFFFu ? 0xFFFFFFFFu : ptr_ones(g->N) + 1u, /* inner: too wide */
             ch[1].b[0].hi = 0x42C80000u;
             break;
-    case 4: ch[0].flags = 2, ch[0].b[0].lo = 0x7FC00000u, ch[0].ptr = 0xFFFFFFFFu; break; /* empty */
+    case 4: ch[0].flags = 2, ch[0].b[0].lo = F_QNAN, ch[0].ptr = 0xFFFFFFFFu; break; /* empty */
     case 5: ch[0].flags = 0xD, ch[1].ptr = ptr_ones(g->N); break; /* unused flag bits; leaf at the marker */
     case 6: ch[0].flags = ch[1].flags = 2; break; /* both empty */
     default: break;
@@ -1528,15 +1528,15 @@ static void reject_combinations_nodepair(gen_t *g, int decode) {
  * -0 against a +0 plane distance or one inside the box (the unit's max/min
  * keep the first of equal values, so -0 can come out). */
 static void reject_combinations_ray_box(gen_t *g) {
-    const cbvh_f32 half = 0x3F000000u, quarter = 0x3E800000u, nan = 0x7FC00000u, pinf = CBVH_F32_POS_INF;
+    const cbvh_f32 half = 0x3F000000u, quarter = 0x3E800000u, pinf = CBVH_F32_POS_INF;
     static const uint32_t rs[][2] = {{0, 8}, {5, 5}, {0x800, 0x801}, {0xFFF, 0}};
     for (int k = 0; k < 128; k++) {
-        cbvh_f32 o[3] = {(k & 1) ? nan : half, half, half};
+        cbvh_f32 o[3] = {(k & 1) ? F_QNAN : half, half, half};
         cbvh_f32 d[3] = {F_ONE, half, quarter};
         if (k & 2) d[0] = d[1] = d[2] = 0;
         int mant = (k & 4) ? 2 : 24;
         int e[3] = {-3, -3, (k & 8) ? 127 : -3};
-        cbvh_f32 u[3] = {0, (k & 16) ? nan : 0, 0};
+        cbvh_f32 u[3] = {0, (k & 16) ? F_QNAN : 0, 0};
         uint32_t r[3] = {0, 0, rs[(k >> 5) & 3][0]}, sv[3] = {8, 8, rs[(k >> 5) & 3][1]};
         emit_ray_box(g, o, d, 0, pinf, mant, u, e, r, sv);
     }
@@ -1561,43 +1561,58 @@ static void reject_combinations_ray_box(gen_t *g) {
  * a ray without NaN/Inf): every combination of a NaN or Inf in the ray, a zero
  * direction (also -0 components) and a bad vertex, centre or radius. */
 static void reject_combinations_ray_tri(gen_t *g) {
-    const cbvh_f32 nan = 0x7FC00000u, pinf = CBVH_F32_POS_INF;
+    const cbvh_f32 pinf = CBVH_F32_POS_INF;
     for (int k = 0; k < 16; k++) {
-        cbvh_f32 o[3] = {(k & 1) ? nan : 0x3E800000u, 0x3E800000u, 0xBF800000u};
+        cbvh_f32 o[3] = {(k & 1) ? F_QNAN : 0x3E800000u, 0x3E800000u, 0xBF800000u};
         cbvh_f32 d[3] = {0, 0, F_ONE};
         if (k & 2) d[2] = (k & 8) ? CBVH_F32_SIGN : 0; /* (0, 0, +-0) */
         cbvh_f32 v[9] = {0, 0, 0, F_ONE, 0, 0, 0, F_ONE, 0};
-        if (k & 4) v[4] = (k & 8) ? pinf : nan;
+        if (k & 4) v[4] = (k & 8) ? pinf : F_QNAN;
         if ((k & 8) && !(k & 2)) d[0] = pinf; /* an Inf direction component */
         emit_ray_tri(g, o, d, v);
     }
 }
 
 static void reject_combinations_ray_sphere(gen_t *g) {
-    const cbvh_f32 nan = 0x7FC00000u, pinf = CBVH_F32_POS_INF;
+    const cbvh_f32 pinf = CBVH_F32_POS_INF;
     for (int k = 0; k < 32; k++) {
-        cbvh_f32 o[3] = {(k & 1) ? nan : 0, 0, 0xC0000000u /* -2 */};
+        cbvh_f32 o[3] = {(k & 1) ? F_QNAN : 0, 0, 0xC0000000u /* -2 */};
         cbvh_f32 d[3] = {0, 0, (k & 2) ? CBVH_F32_SIGN : F_ONE};
         cbvh_f32 tmin = (k & 16) ? pinf : 0, tmax = pinf;
-        cbvh_f32 c[3] = {0, (k & 4) ? nan : 0, 0};
+        cbvh_f32 c[3] = {0, (k & 4) ? F_QNAN : 0, 0};
         cbvh_f32 r = (k & 8) ? 0xBF800000u /* -1 */ : F_ONE;
         emit_ray_sphere(g, o, d, tmin, tmax, c, r);
     }
 }
 
+static void reject_combinations_encode_pair(gen_t *g) { reject_combinations_nodepair(g, 0); }
+static void reject_combinations_decode_pair(gen_t *g) { reject_combinations_nodepair(g, 1); }
+
 /* ---- files ------------------------------------------------------------------- */
 
-/* Vectors of a level-1 file per unit (the committed set stays small). */
-static size_t level1_target(const cbvh_unit *u) {
-    if (strcmp(u->name, "scale_estimate") == 0) return 2000;
-    if (strcmp(u->name, "axis_compress") == 0) return 2000;
-    if (strcmp(u->name, "axis_decode") == 0) return 1500;
-    if (strcmp(u->name, "ray_box") == 0) return 1500;
-    if (strcmp(u->name, "ray_triangle") == 0) return 1500;
-    if (strcmp(u->name, "qbvh_stack") == 0) return 2000;
-    if (strcmp(u->name, "ray_sphere") == 0) return 1500;
-    return 500;
-}
+/* Per unit: the size of a level-1 file before the appended cases (the
+ * committed set stays small), its generator, the exact-path cases of the ray
+ * units (generator 2) and the reject combinations (generator 3). */
+typedef struct {
+    const char *unit;
+    size_t level1;
+    void (*gen)(gen_t *, size_t);
+    void (*exact)(gen_t *, rng_t *, int);
+    int n_exact;
+    void (*rejects)(gen_t *);
+} unit_gen;
+
+static const unit_gen unit_gens[] = {
+    {"scale_estimate", 2000, gen_estimate, NULL, 0, NULL},
+    {"axis_compress", 2000, gen_compress, NULL, 0, reject_combinations_compress},
+    {"axis_decode", 1500, gen_decode, NULL, 0, reject_combinations_decode},
+    {"nodepair_encode", 500, gen_encode_pair, NULL, 0, reject_combinations_encode_pair},
+    {"nodepair_decode", 500, gen_decode_pair, NULL, 0, reject_combinations_decode_pair},
+    {"ray_box", 1500, gen_ray_box, exact_ray_box, EXACT_CASES_BOX, reject_combinations_ray_box},
+    {"ray_triangle", 1500, gen_ray_triangle, exact_ray_triangle, EXACT_CASES_TRI, reject_combinations_ray_tri},
+    {"qbvh_stack", 2000, gen_qbvh_stack, NULL, 0, reject_combinations_qstack},
+    {"ray_sphere", 1500, gen_ray_sphere, exact_ray_sphere, EXACT_CASES_SPHERE, reject_combinations_ray_sphere},
+};
 
 static void stem(const cbvh_vecgen_spec *s, char *buf, size_t n) {
     if (s->unit->uses_encoding)
@@ -1630,39 +1645,19 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     for (const char *c = st; *c; c++) h = (h ^ (uint8_t)*c) * UINT64_C(0x100000001B3);
     rng_seed(&g.rng, s->seed ^ h);
 
-    size_t target = level1_target(s->unit);
-    void (*fn)(gen_t *, size_t) = NULL;
-    if (strcmp(s->unit->name, "scale_estimate") == 0) fn = gen_estimate;
-    else if (strcmp(s->unit->name, "axis_compress") == 0) fn = gen_compress;
-    else if (strcmp(s->unit->name, "axis_decode") == 0) fn = gen_decode;
-    else if (strcmp(s->unit->name, "nodepair_encode") == 0) fn = gen_encode_pair;
-    else if (strcmp(s->unit->name, "nodepair_decode") == 0) fn = gen_decode_pair;
-    else if (strcmp(s->unit->name, "ray_box") == 0) fn = gen_ray_box;
-    else if (strcmp(s->unit->name, "ray_triangle") == 0) fn = gen_ray_triangle;
-    else if (strcmp(s->unit->name, "qbvh_stack") == 0) fn = gen_qbvh_stack;
-    else if (strcmp(s->unit->name, "ray_sphere") == 0) fn = gen_ray_sphere;
-    if (!fn) return -1;
-    void (*exact)(gen_t *, rng_t *, int) = NULL;
-    int n_exact = 0;
-    if (fn == gen_ray_box) exact = exact_ray_box, n_exact = EXACT_CASES_BOX;
-    if (fn == gen_ray_triangle) exact = exact_ray_triangle, n_exact = EXACT_CASES_TRI;
-    if (fn == gen_ray_sphere) exact = exact_ray_sphere, n_exact = EXACT_CASES_SPHERE;
-    fn(&g, target);
+    const unit_gen *ug = NULL;
+    for (size_t i = 0; i < sizeof unit_gens / sizeof unit_gens[0]; i++)
+        if (strcmp(s->unit->name, unit_gens[i].unit) == 0) ug = &unit_gens[i];
+    if (!ug) return -1;
+    ug->gen(&g, ug->level1);
     rng_t ex; /* generator 2: the exact-path cases, from a stream of their own */
     rng_seed(&ex, s->seed ^ h ^ UINT64_C(0xE7AC7CA5E5000002));
-    if (exact) exact(&g, &ex, n_exact);
-    if (fn == gen_compress) reject_combinations_compress(&g);
-    if (fn == gen_decode) reject_combinations_decode(&g);
-    if (fn == gen_qbvh_stack) reject_combinations_qstack(&g);
-    if (fn == gen_ray_box) reject_combinations_ray_box(&g);
-    if (fn == gen_ray_triangle) reject_combinations_ray_tri(&g);
-    if (fn == gen_ray_sphere) reject_combinations_ray_sphere(&g);
-    if (fn == gen_encode_pair) reject_combinations_nodepair(&g, 0);
-    if (fn == gen_decode_pair) reject_combinations_nodepair(&g, 1);
+    if (ug->exact) ug->exact(&g, &ex, ug->n_exact);
+    if (ug->rejects) ug->rejects(&g);
     if (s->level >= 2) {
         g.random_only = 1;
-        fn(&g, g.n + CBVH_VECGEN_LEVEL2_RANDOM);
-        if (exact) exact(&g, &ex, CBVH_VECGEN_LEVEL2_EXACT);
+        ug->gen(&g, g.n + CBVH_VECGEN_LEVEL2_RANDOM);
+        if (ug->exact) ug->exact(&g, &ex, CBVH_VECGEN_LEVEL2_EXACT);
     }
     if (g.oom) {
         free(g.in);

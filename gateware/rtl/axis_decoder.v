@@ -69,6 +69,34 @@ module cbvh_axis_decoder_pack (
                          {neg, body};
 endmodule
 
+// A node's context (§8), checked as §7 and §9 require and brought to the
+// child grid (Fig. 4 line 1): shared by the decoder and the node-pair encoder,
+// so both reject the same contexts.
+module cbvh_axis_ctx #(
+    parameter integer N     = 6,
+    parameter integer E_MIN = -30
+) (
+    input  wire [7:0]   parent_scale,
+    input  wire [7:0]   scale,
+    input  wire [11:0]  node_lb_mod,
+    input  wire [31:0]  node_clb,
+    output wire         bad_scale,  // scale < e_min, parent_scale > 126 or < scale
+    output wire         bad_code,   // node_lb_mod >= 2^N
+    output wire         nan_inf,    // node_clb NaN or +Inf; -Inf is the valid value -2^128 (§3)
+    output wire [N-1:0] p_hat       // node r_hat at the child scale; 0 once the shift reaches N
+);
+    localparam [9:0] E_MIN10 = E_MIN[9:0];
+    localparam [9:0] N10 = N[9:0];
+    wire [9:0] ps10 = {{2{parent_scale[7]}}, parent_scale};
+    wire [9:0] e10  = {{2{scale[7]}}, scale};
+    assign bad_scale = ($signed(e10) < $signed(E_MIN10)) || ($signed(e10) > 10'sd126) ||
+                       ($signed(ps10) > 10'sd126) || ($signed(ps10) < $signed(e10));
+    assign bad_code = |node_lb_mod[11:N];
+    assign nan_inf  = (&node_clb[30:23]) & ((|node_clb[22:0]) | ~node_clb[31]);
+    wire [9:0] sh = ps10 - e10;               // parent_scale - scale (>= 0 if valid)
+    assign p_hat = ($signed(sh) >= $signed(N10)) ? {N{1'b0}} : (node_lb_mod[N-1:0] << sh[3:0]);
+endmodule
+
 module cbvh_axis_decoder #(
     parameter integer N      = 6,
     parameter integer E_MIN  = -30,
@@ -95,24 +123,19 @@ module cbvh_axis_decoder #(
     localparam [9:0] N10 = N[9:0];
 
     // ---------------------------------------------------------------- checks
-    wire [9:0] ps10 = {{2{parent_scale[7]}}, parent_scale};
     wire [9:0] e10  = {{2{scale[7]}}, scale};
-    wire bad_scale = ($signed(e10) < $signed(E_MIN10)) || ($signed(e10) > 10'sd126) ||
-                     ($signed(ps10) > 10'sd126) || ($signed(ps10) < $signed(e10));
-    wire bad_node_code  = |node_lb_mod[11:N];
+    wire bad_scale, bad_node_code, nan_inf;
+    wire [N-1:0] p_hat;
+    cbvh_axis_ctx #(.N(N), .E_MIN(E_MIN)) ctx (
+        .parent_scale(parent_scale), .scale(scale), .node_lb_mod(node_lb_mod), .node_clb(node_clb),
+        .bad_scale(bad_scale), .bad_code(bad_node_code), .nan_inf(nan_inf), .p_hat(p_hat));
     wire bad_child_code = (|lb_code[11:N]) | (|ub_code[11:N]);
     wire bad_code  = bad_node_code | bad_child_code;
     wire clb_sign = node_clb[31];
     wire [7:0]  clb_ef = node_clb[30:23];
     wire [22:0] clb_fr = node_clb[22:0];
-    // NaN or +Inf; -Inf is the valid value -2^128 (§3)
-    wire nan_inf = (&clb_ef) & ((|clb_fr) | ~clb_sign);
 
-    // ---------------------------------------------- Fig. 4 line 1 and Eq. 9
-    wire [9:0] sh = ps10 - e10;               // parent_scale - scale (>= 0 if valid)
-    wire [N-1:0] nlm = node_lb_mod[N-1:0];
-    // p_hat = node r_hat at the child scale; 0 once the shift reaches N
-    wire [N-1:0] p_hat = ($signed(sh) >= $signed(N10)) ? {N{1'b0}} : (nlm << sh[3:0]);
+    // ---------------------------------------------- Eq. 9
 
     wire [N-1:0] r_lo, s_lo, lbm, ubm;
     generate

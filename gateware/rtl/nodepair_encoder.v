@@ -65,8 +65,6 @@ module cbvh_nodepair_encoder #(
     localparam [0:0]  BAD_PARAM = (N < 3) || (N > 10) || (E_MIN < -126) || (E_MIN > 126);
     localparam integer NW  = (N <= 6) ? 64 : 96;                  // node width W
     localparam integer P   = (NW - 6 * N - 1 > 32) ? 32 : NW - 6 * N - 1;
-    localparam signed [9:0] EMIN10 = E_MIN[9:0];
-    localparam signed [9:0] NS10   = N[9:0];
     localparam [31:0] PMAX = (P >= 32) ? 32'hFFFFFFFF : ((32'd1 << P) - 32'd1); // 2^P - 1
 
     // ---- per-axis context: check and p^ ------------------------------------------
@@ -81,25 +79,17 @@ module cbvh_nodepair_encoder #(
     genvar a;
     generate
         for (a = 0; a < 3; a = a + 1) begin : g_ctx
-            wire signed [9:0] ps  = {{2{ps_all[8*a+7]}}, ps_all[8*a +: 8]};
-            wire signed [9:0] sc  = {{2{sc_all[8*a+7]}}, sc_all[8*a +: 8]};
-            wire [11:0]       lbm = lbm_all[12*a +: 12];
-            wire [31:0]       clb = clb_all[32*a +: 32];
-            wire bad_scale = (sc < EMIN10) || (sc > 10'sd126) ||
-                             (ps > 10'sd126) || (ps < sc);
-            wire bad_code  = (lbm >= (12'd1 << N));
-            // NaN or +Inf (-Inf means -2^128 and is valid)
-            wire nan_pinf  = (&clb[30:23]) & ((|clb[22:0]) | ~clb[31]);
+            wire bad_scale, bad_code, nan_pinf;
+            // the decoder's context check and p^ (axis_decoder.v), so both
+            // directions reject the same contexts
+            cbvh_axis_ctx #(.N(N), .E_MIN(E_MIN)) ctx (
+                .parent_scale(ps_all[8*a +: 8]), .scale(sc_all[8*a +: 8]),
+                .node_lb_mod(lbm_all[12*a +: 12]), .node_clb(clb_all[32*a +: 32]),
+                .bad_scale(bad_scale), .bad_code(bad_code), .nan_inf(nan_pinf), .p_hat(phat[N*a +: N]));
             // one reject bit per context, in the decoder's order (section 10)
             assign ctx_scale[a] = ~BAD_PARAM & bad_scale;
             assign ctx_code[a]  = ~BAD_PARAM & ~bad_scale & bad_code;
             assign ctx_nan[a]   = ~BAD_PARAM & ~bad_scale & ~bad_code & nan_pinf;
-            // p^ = (lb_mod << (ps - sc)) mod 2^N, 0 if the shift is >= N; only used
-            // when the context is valid (shift >= 0 then)
-            wire signed [9:0] sh  = ps - sc;
-            wire [3:0]        shc = (sh < 10'sd0 || sh >= NS10) ? 4'd0 : sh[3:0];
-            wire [N-1:0]      ph  = lbm[N-1:0] << shc;
-            assign phat[N*a +: N] = (sh >= NS10) ? {N{1'b0}} : ph;
         end
     endgenerate
 

@@ -51,6 +51,16 @@ static uint32_t get_bits(const node_bits *n, int pos, int width) {
     return (uint32_t)(x & ((UINT64_C(1) << width) - 1));
 }
 
+/* Both directions check the node's context first, with the same rule, so
+ * they reject the same contexts: relative codes depend on parent_scale -
+ * scale, and a pair of two empty children runs no axis unit that would
+ * (docs/datapath.md §9). */
+static uint32_t node_ctx_check(const cbvh_params *p, const cbvh_node_ctx *ctx) {
+    uint32_t st = 0;
+    for (int a = 0; a < 3; a++) st |= cbvh_axis_ctx_check(p, &ctx->axis[a]);
+    return st;
+}
+
 uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbvh_node_ctx *ctx,
                               const cbvh_child_in child[2], uint8_t *bytes, cbvh_child_out out[2]) {
     int n = p->quant_bits;
@@ -60,9 +70,7 @@ uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbv
     size_t nb = cbvh_nodepair_bytes(n);
     int w = cbvh_node_bits(n), pb = cbvh_node_ptr_bits(n);
     uint32_t ones = ptr_all_ones(n);
-    /* The context is checked as the decoder checks it, so both directions
-     * reject the same contexts (relative codes depend on parent_scale - scale). */
-    for (int a = 0; a < 3; a++) st |= cbvh_axis_ctx_check(p, &ctx->axis[a]);
+    st = node_ctx_check(p, ctx);
     if (st) {
         memset(bytes, 0, nb); /* bytes and outputs are zero */
         return st;
@@ -105,10 +113,7 @@ uint32_t cbvh_nodepair_decode(const cbvh_params *p, cbvh_encoding enc, const cbv
     if (st) return st;
     int w = cbvh_node_bits(n), pb = cbvh_node_ptr_bits(n);
     uint32_t ones = ptr_all_ones(n);
-    /* The context first, as the encoder checks it: a pair of two empty
-     * children runs no axis unit, and must not decode under a context the
-     * encoder rejects (docs/datapath.md §9). */
-    for (int a = 0; a < 3; a++) st |= cbvh_axis_ctx_check(p, &ctx->axis[a]);
+    st = node_ctx_check(p, ctx);
     if (st) return st;
     for (int c = 0; c < 2; c++) {
         const node_bits nb_c = load_node(bytes + (size_t)c * (size_t)w / 8u, w / 8), *node = &nb_c;
