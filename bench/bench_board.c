@@ -67,7 +67,7 @@ typedef struct {
 } board_thread;
 static void *board_main(void *arg) {
     board_thread *b = arg;
-    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, NULL, 0, 0};
+    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, NULL, 0, 0, NULL};
     cbvh_sim_board_serve(&o);
     return NULL;
 }

@@ -1,4 +1,5 @@
 /* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,8 +19,11 @@ static void on_signal(int sig) {
 #define RX_IDLE_MS_MAX 60000
 
 static void usage(FILE *f) {
-    fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--faults SPEC] [--rx-idle-ms N] [--break-unit UNIT] [--verbose]\n"
+    fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--gateware PROG] [--faults SPEC] [--rx-idle-ms N]\n"
+               "                      [--break-unit UNIT] [--verbose]\n"
                "  Runs the virtual board: the firmware core with the bit-exact model as its FPGA,\n"
+               "  or with --gateware the board's RTL simulated by Icarus Verilog (PROG from\n"
+               "  gateware/scripts/build-board-sim), driven over SPI as on the board;\n"
                "  reachable with --backend sim:ADDR.  ADDR: unix:PATH (default unix:/tmp/cbvh-board-UID.sock)\n"
                "  or tcp:HOST:PORT (PORT 1..65535).  --faults injects faults into the replies, e.g.\n"
                "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1\n"
@@ -33,7 +37,7 @@ static void usage(FILE *f) {
 int cmd_board_sim(int argc, char **argv) {
     char def[128];
     snprintf(def, sizeof def, "unix:/tmp/cbvh-board-%u.sock", (unsigned)getuid());
-    const char *addr = def, *faults = NULL;
+    const char *addr = def, *faults = NULL, *gateware = NULL;
     int idle = 20, verbose = 0, broken = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
@@ -41,6 +45,8 @@ int cmd_board_sim(int argc, char **argv) {
             return 0;
         } else if (strcmp(argv[i], "--listen") == 0 && i + 1 < argc) {
             addr = argv[++i];
+        } else if (strcmp(argv[i], "--gateware") == 0 && i + 1 < argc) {
+            gateware = argv[++i];
         } else if (strcmp(argv[i], "--faults") == 0 && i + 1 < argc) {
             faults = argv[++i];
         } else if (strcmp(argv[i], "--rx-idle-ms") == 0 && i + 1 < argc) {
@@ -72,9 +78,24 @@ int cmd_board_sim(int argc, char **argv) {
         fprintf(stderr, "cbvh board-sim: --faults: %s\n", err);
         return 2;
     }
+    if (cbvh_sim_addr_check(addr, err, sizeof err)) {
+        fprintf(stderr, "cbvh board-sim: --listen: %s\n", err);
+        return 2;
+    }
+    cbvh_gateware *gw = NULL;
+    if (gateware && access(gateware, R_OK) != 0) { /* bad input: exit 2, as a bad address */
+        fprintf(stderr, "cbvh board-sim: --gateware: cannot read '%s': %s (build it with gateware/scripts/build-board-sim)\n",
+                gateware, strerror(errno));
+        return 2;
+    }
+    if (gateware && !(gw = cbvh_gateware_start(gateware, broken, err, sizeof err))) {
+        fprintf(stderr, "cbvh board-sim: --gateware: %s\n", err);
+        return 1;
+    }
     int fd = cbvh_sim_listen(addr, err, sizeof err);
     if (fd < 0) {
         fprintf(stderr, "cbvh board-sim: %s%s\n", fd == CBVH_SIM_BAD_ADDR ? "--listen: " : "", err);
+        cbvh_gateware_stop(gw);
         return fd == CBVH_SIM_BAD_ADDR ? 2 : 1; /* bad input, or the socket could not be opened */
     }
     struct sigaction sa;
@@ -85,10 +106,17 @@ int cmd_board_sim(int argc, char **argv) {
     signal(SIGPIPE, SIG_IGN);
     printf("cbvh board-sim: listening on %s\n", addr);
     fflush(stdout);
-    cbvh_sim_board_opts o = {fd, &stop_flag, idle, faults ? &fl : NULL, verbose, broken};
+    cbvh_sim_board_opts o = {fd, &stop_flag, idle, faults ? &fl : NULL, verbose, broken, gw};
     int rc = cbvh_sim_board_serve(&o);
     close(fd);
     cbvh_sim_unlink(addr);
+    if (gw) {
+        if (cbvh_gateware_error(gw)) fprintf(stderr, "cbvh board-sim: %s\n", cbvh_gateware_error(gw));
+        else if (verbose)
+            fprintf(stderr, "cbvh board-sim: %llu SPI transactions\n",
+                    (unsigned long long)cbvh_gateware_transactions(gw));
+        cbvh_gateware_stop(gw);
+    }
     if (faults) {
         fprintf(stderr, "cbvh board-sim: reply frames %llu, faults injected:", (unsigned long long)fl.frames);
         for (int k = 0; k < CBVH_FAULT_KINDS; k++)

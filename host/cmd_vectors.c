@@ -55,6 +55,8 @@ static void usage_check(FILE *f) {
                "  -b, --backend B        auto (default: board if found, else the model), model, usb, hid,\n"
                "                         or sim:ADDR (the virtual board: sim:unix:PATH, sim:tcp:HOST:PORT)\n"
                "  -M, --max-errors K     mismatches shown in full (default 20)\n"
+               "  -s, --sample K         at most K vectors per file, evenly spread (for a slow board or\n"
+               "                         a simulated FPGA; default: every vector)\n"
                "  -j, --json             one JSON object instead of text\n"
                "  -q, --quiet            no per-file lines for files that pass\n"
                "  -h, --help             this text\n"
@@ -239,6 +241,7 @@ static int cmd_gen(int argc, char **argv) {
 
 static int cmd_check(int argc, char **argv) {
     static const struct option lo[] = {{"backend", required_argument, 0, 'b'}, {"max-errors", required_argument, 0, 'M'},
+                                       {"sample", required_argument, 0, 's'},
                                        {"json", no_argument, 0, 'j'},         {"quiet", no_argument, 0, 'q'},
                                        {"help", no_argument, 0, 'h'},         {0, 0, 0, 0}};
     cbvh_check_opts o;
@@ -249,7 +252,7 @@ static int cmd_check(int argc, char **argv) {
     long v;
     optind = 0;
     opterr = 0;
-    while ((c = getopt_long(argc, argv, "b:M:jqh", lo, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "b:M:s:jqh", lo, NULL)) != -1) {
         switch (c) {
         case 'b': o.backend = optarg; break;
         case 'M':
@@ -258,6 +261,13 @@ static int cmd_check(int argc, char **argv) {
                 return 2;
             }
             o.max_errors = (int)v;
+            break;
+        case 's':
+            if (cbvh_parse_long(optarg, 1, LONG_MAX, &v)) {
+                fprintf(stderr, "cbvh vectors check: --sample must be a count >= 1, not '%s'\n", optarg);
+                return 2;
+            }
+            o.sample = (size_t)v;
             break;
         case 'j': o.json = 1; break;
         case 'q': o.quiet = 1; break;

@@ -10,6 +10,22 @@
 #define RUN_HDR 12u
 #define RUN_REPLY_HDR 4u
 
+/* What a request-class error code means, for the one-line message
+ * (docs/protocol.md, "Error replies"). */
+static const char *request_error_meaning(unsigned code) {
+    switch (code) {
+    case CBVH_E_HEADER: return "the request's status byte was not 0";
+    case CBVH_E_COMMAND: return "the board does not know the command";
+    case CBVH_E_PAYLOAD: return "payload size or fields wrong for the command";
+    case CBVH_E_UNIT: return "the board's datapath has no such unit";
+    case CBVH_E_SHAPE: return "the board's unit has another number of input or output words";
+    case CBVH_E_TOO_BIG: return "the reply would not fit one frame";
+    case CBVH_E_DATAPATH: return "the datapath did not finish or flagged an error";
+    case CBVH_E_CONFIG: return "the board's unit is not built for this N, min_scale or encoding";
+    default: return "unknown code";
+    }
+}
+
 static long now_ms(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -142,8 +158,8 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
                             continue;
                         }
                         l->st.failures++;
-                        snprintf(err, errlen, "board rejected command 0x%02x: %s error", cmd,
-                                 cbvh_error_name(f.status));
+                        snprintf(err, errlen, "board rejected command 0x%02x: %s error (%s)", cmd,
+                                 cbvh_error_name(f.status), request_error_meaning(f.status));
                         return -1;
                     }
                     memcpy(l->reply, f.payload, f.len);

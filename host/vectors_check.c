@@ -256,6 +256,28 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
             act = na;
             act_cap = need;
         }
+        /* --sample: vectors k * count / m, k < m, copied together so that a
+         * batch stays one contiguous run for the backend. */
+        size_t m = vf.count, *pick = NULL;
+        uint32_t *picked_in = NULL;
+        if (o.sample && o.sample < vf.count) {
+            m = o.sample;
+            pick = malloc(m * sizeof *pick);
+            picked_in = malloc(m * (size_t)l->n_in * sizeof *picked_in);
+            if (!pick || !picked_in) {
+                free(pick);
+                free(picked_in);
+                snprintf(err, sizeof err, "out of memory");
+                cbvh_vecfile_free(&vf);
+                goto done_json;
+            }
+            for (size_t k = 0; k < m; k++) {
+                pick[k] = k * vf.count / m;
+                memcpy(picked_in + k * (size_t)l->n_in, vf.in + pick[k] * (size_t)l->n_in,
+                       (size_t)l->n_in * sizeof *picked_in);
+            }
+        }
+        const uint32_t *run_in = picked_in ? picked_in : vf.in;
         size_t pass = 0, fail = 0;
         int shown_here = 0;
         in_obj = o.json;
@@ -264,36 +286,43 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
             json_str(out, path);
             fprintf(out, ", \"unit\": \"%s\", \"mismatches\": [", vf.unit->name);
         }
-        for (size_t off = 0; off < vf.count; off += batch) {
-            size_t cnt = vf.count - off < batch ? vf.count - off : batch;
+        for (size_t off = 0; off < m; off += batch) {
+            size_t cnt = m - off < batch ? m - off : batch;
             char berr[512] = "";
             memset(act, 0, cnt * (size_t)l->n_out * sizeof *act);
-            if (be.ops->run(&be, vf.unit, &vf.cfg, vf.in + off * (size_t)l->n_in, act, cnt, berr, sizeof berr) != 0) {
+            if (be.ops->run(&be, vf.unit, &vf.cfg, run_in + off * (size_t)l->n_in, act, cnt, berr, sizeof berr) != 0) {
                 snprintf(err, sizeof err, "%s: backend %s failed: %s", path, be.label, berr);
+                free(pick);
+                free(picked_in);
                 cbvh_vecfile_free(&vf);
                 goto done_json;
             }
             for (size_t i = 0; i < cnt; i++) {
-                const uint32_t *a = act + i * (size_t)l->n_out, *e = vf.out + (off + i) * (size_t)l->n_out;
+                size_t v = pick ? pick[off + i] : off + i;
+                const uint32_t *a = act + i * (size_t)l->n_out, *e = vf.out + v * (size_t)l->n_out;
                 if (memcmp(a, e, (size_t)l->n_out * sizeof *a) == 0) {
                     pass++;
                     continue;
                 }
                 fail++;
-                if (printed < o.max_errors && !o.json) print_mismatch_text(out, path, &vf, off + i, a);
+                if (printed < o.max_errors && !o.json) print_mismatch_text(out, path, &vf, v, a);
                 if (printed < o.max_errors && o.json) {
                     fprintf(out, "%s", shown_here ? ", " : "");
-                    json_mismatch(out, path, &vf, off + i, a);
+                    json_mismatch(out, path, &vf, v, a);
                     shown_here++;
                 }
                 printed++;
             }
         }
+        free(pick);
+        free(picked_in);
         if (o.json) {
-            fprintf(out, "], \"passed\": %zu, \"failed\": %zu}", pass, fail);
+            fprintf(out, "], \"passed\": %zu, \"failed\": %zu, \"count\": %zu}", pass, fail, vf.count);
             in_obj = 0;
         } else if (!o.quiet || fail) {
-            fprintf(out, "%s: %zu passed, %zu failed\n", path, pass, fail);
+            fprintf(out, "%s: %zu passed, %zu failed", path, pass, fail);
+            if (m < vf.count) fprintf(out, " (a sample of %zu of its %zu vectors)", m, vf.count);
+            fprintf(out, "\n");
         }
         sum.files++;
         sum.passed += pass;

@@ -27,6 +27,7 @@ typedef struct {
     FILE *out;           /* report (NULL = stdout) */
     FILE *log;           /* one-line notes and errors (NULL = stderr) */
     size_t batch;        /* vectors per backend call (0 = CBVH_CHECK_BATCH) */
+    size_t sample;       /* at most this many vectors per file, evenly spread (0 = all): for slow backends */
     cbvh_check_summary *summary; /* optional: filled on return */
     const char *who;     /* prefix of error lines (NULL = "cbvh vectors check") */
 } cbvh_check_opts;

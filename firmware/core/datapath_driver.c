@@ -7,11 +7,12 @@ uint32_t cbvh_dp_config_word(const cbvh_fw_config *c) {
     return (uint32_t)(uint8_t)c->quant_bits | (uint32_t)(uint16_t)c->min_scale << 8 | (uint32_t)(c->encoding & 1u) << 24;
 }
 
-uint32_t cbvh_dp_select(const cbvh_fw_hal *hal, uint8_t unit, const cbvh_fw_config *c) {
-    if (unit >= 32 || !(hal->reg_read(hal->ctx, CBVH_REG_UNITS) & (1u << unit))) return 0;
+int cbvh_dp_select(const cbvh_fw_hal *hal, uint8_t unit, const cbvh_fw_config *c, uint32_t *shape) {
+    if (unit >= 32 || !(hal->reg_read(hal->ctx, CBVH_REG_UNITS) & (1u << unit))) return CBVH_E_UNIT;
     hal->reg_write(hal->ctx, CBVH_REG_CONFIG, cbvh_dp_config_word(c));
     hal->reg_write(hal->ctx, CBVH_REG_UNIT_SEL, unit);
-    return hal->reg_read(hal->ctx, CBVH_REG_SHAPE) & 0xFFFFu;
+    *shape = hal->reg_read(hal->ctx, CBVH_REG_SHAPE) & 0xFFFFu;
+    return *shape ? CBVH_E_OK : CBVH_E_CONFIG;
 }
 
 int cbvh_dp_run_one(const cbvh_fw_hal *hal, const uint8_t *in_le, unsigned n_in, uint8_t *out_le, unsigned n_out) {

@@ -66,9 +66,10 @@ static void do_run(cbvh_fw *fw, const cbvh_frame *f) {
         reply_error(fw, CBVH_CMD_RUN, CBVH_E_PAYLOAD, f->seq);
         return;
     }
-    uint32_t shape = cbvh_dp_select(fw->hal, unit, &cfg);
-    if (shape == 0) {
-        reply_error(fw, CBVH_CMD_RUN, CBVH_E_UNIT, f->seq);
+    uint32_t shape = 0;
+    int sel = cbvh_dp_select(fw->hal, unit, &cfg, &shape);
+    if (sel != CBVH_E_OK) {
+        reply_error(fw, CBVH_CMD_RUN, (uint8_t)sel, f->seq);
         return;
     }
     if ((shape & 0xFFu) != n_in || (shape >> 8) != n_out || n_in > CBVH_REG_WORDS || n_out > CBVH_REG_WORDS ||

@@ -4,7 +4,7 @@
 # part, nothing ignored).  A board-sim that does start (on a private socket)
 # is killed after 5 s, which fails the case.
 # Usage: cli_bad_input.sh PATH/TO/cbvh GROUP VECTOR-DIR
-#   GROUP: listen, rx_idle, faults, env, devices_sim; VECTOR-DIR: a valid one, so
+#   GROUP: listen, rx_idle, faults, env, devices_sim, gateware; VECTOR-DIR: a valid one, so
 #   that `vectors check` gets as far as opening its backend
 set -u
 cbvh=$1
@@ -94,6 +94,33 @@ devices_sim)
     expect 2 "backend 'sim:foo': bad board address 'foo'" -- vectors check --backend sim:foo "$vec"
     if grep -q "board-sim --listen" "$tmp/err"; then
         echo "FAIL: the error suggests an invalid board-sim command"; fails=$((fails + 1))
+    fi
+    ;;
+gateware)
+    expect 2 "cbvh board-sim: --gateware: cannot read '$tmp/none.vvp': No such file or directory" \
+        -- board-sim --listen "unix:$tmp/b.sock" --gateware "$tmp/none.vvp"
+    # A simulation that ends under the board: the host's check fails, and
+    # board-sim stops with one line saying so (exit 1), not a hang.
+    printf '#!/bin/sh\nexit 3\n' >"$tmp/dies"
+    chmod +x "$tmp/dies"
+    "$cbvh" board-sim --listen "unix:$tmp/g.sock" --gateware "$tmp/dies" >/dev/null 2>"$tmp/board.err" &
+    bpid=$!
+    i=0
+    while [ ! -S "$tmp/g.sock" ] && [ $i -lt 250 ]; do sleep 0.02; i=$((i + 1)); done
+    CBVH_LINK_RETRIES=0 timeout 20 "$cbvh" vectors check --backend "sim:unix:$tmp/g.sock" --sample 1 \
+        "$vec/axis_compress-N6-ms-30.vec" >"$tmp/out" 2>"$tmp/err"
+    rc=$?
+    i=0
+    while kill -0 $bpid 2>/dev/null && [ $i -lt 250 ]; do sleep 0.02; i=$((i + 1)); done
+    kill $bpid 2>/dev/null
+    wait $bpid
+    brc=$?
+    if [ "$rc" = 2 ] && [ "$brc" = 1 ] && [ "$(wc -l <"$tmp/board.err")" = 1 ] &&
+        grep -q -F "cbvh board-sim: gateware simulation ended (exit status 3)" "$tmp/board.err"; then
+        echo "ok: a dying simulation: check exit $rc, board-sim exit $brc: $(cat "$tmp/board.err")"
+    else
+        echo "FAIL: a dying simulation: check exit $rc (want 2), board-sim exit $brc (want 1), board-sim said:"
+        sed 's/^/    /' "$tmp/board.err"; fails=$((fails + 1))
     fi
     ;;
 *)

@@ -170,6 +170,25 @@ static void absent_unit(void **s) {
     assert_int_equal(reply_at(0).status, CBVH_E_UNIT);
 }
 
+/* A datapath that has the unit but not for this configuration (gateware built
+ * for another N): SHAPE reads 0 after the select, and the reply is config,
+ * not unit, with no vector run. */
+static void unit_not_built_for_config(void **s) {
+    (void)s;
+    uint8_t p[12];
+    run_header(p, 2, 7, -30, 0, 3, 6, 0);
+    expect_read(CBVH_REG_UNITS, 0x10Eu);
+    expect_write(CBVH_REG_CONFIG, 7u | (uint32_t)(uint16_t)-30 << 8);
+    expect_write(CBVH_REG_UNIT_SEL, 2);
+    expect_read(CBVH_REG_SHAPE, 0);
+    send_frame(CBVH_CMD_RUN, 4, p, sizeof p);
+    cbvh_frame f = reply_at(0);
+    assert_int_equal(f.status, CBVH_E_CONFIG);
+    assert_int_equal(f.seq, 4);
+    assert_int_equal(f.len, 0);
+    assert_string_equal(cbvh_error_name(CBVH_E_CONFIG), "config");
+}
+
 /* ---- fake HAL: the model-backed register map, for the malformed-frame storm ---- */
 static cbvh_regmap_model regs;
 static const cbvh_fw_hal fake_hal = {&regs, cbvh_regmap_model_read, cbvh_regmap_model_write, capture_send, "fake"};
@@ -330,6 +349,7 @@ int main(void) {
         cmocka_unit_test_setup(run_register_sequence, setup),
         cmocka_unit_test_setup(datapath_hang, setup),
         cmocka_unit_test_setup(absent_unit, setup),
+        cmocka_unit_test_setup(unit_not_built_for_config, setup),
         cmocka_unit_test_setup(malformed_frames_each_get_an_error, setup_fake),
         cmocka_unit_test_setup(run_matches_model, setup_fake),
     };

@@ -48,6 +48,7 @@ enum {
     CBVH_E_SHAPE = 10,     /* host's n_in/n_out differ from the datapath's */
     CBVH_E_TOO_BIG = 11,   /* batch exceeds one frame */
     CBVH_E_DATAPATH = 12,  /* datapath did not finish / flagged an error */
+    CBVH_E_CONFIG = 13,    /* unit present but not built for this N / min_scale / encoding */
 };
 
 #define CBVH_IDENTITY_BYTES 40 /* IDENTIFY reply payload; layout in fw.h */

@@ -58,9 +58,10 @@ typedef struct {
     uint8_t encoding;
 } cbvh_fw_config;
 uint32_t cbvh_dp_config_word(const cbvh_fw_config *c);
-/* Selects unit and config, returns shape (n_in | n_out << 8), or 0 when the
- * unit is absent. */
-uint32_t cbvh_dp_select(const cbvh_fw_hal *hal, uint8_t unit, const cbvh_fw_config *c);
+/* Selects unit and config: CBVH_E_OK with *shape = n_in | n_out << 8,
+ * CBVH_E_UNIT when the unit is absent, CBVH_E_CONFIG when the datapath has
+ * the unit but not for this configuration (SHAPE reads 0). */
+int cbvh_dp_select(const cbvh_fw_hal *hal, uint8_t unit, const cbvh_fw_config *c, uint32_t *shape);
 /* Runs one vector: 0 or CBVH_E_DATAPATH. */
 int cbvh_dp_run_one(const cbvh_fw_hal *hal, const uint8_t *in_le, unsigned n_in, uint8_t *out_le, unsigned n_out);
 

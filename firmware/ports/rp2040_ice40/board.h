@@ -7,7 +7,14 @@
 #define BOARD_PIN_SPI_CS 17   /* driven by SIO, active low */
 #define BOARD_PIN_SPI_SCK 18
 #define BOARD_PIN_SPI_TX 19   /* MCU -> FPGA (COPI) */
-#define BOARD_SPI_PRESCALE 2  /* clk_peri / 2 */
+/* SCK = clk_peri / 8.  The gateware's SPI slave oversamples (gateware/board/
+ * spi_slave.v): SCK at most 1/8 of the FPGA's 12 MHz clock, 1.5 MHz.  clk_peri
+ * is clk_sys, still on the ring oscillator (this port sets up no PLL): at most
+ * 12 MHz, so /8 stays within the limit. */
+#define BOARD_SPI_PRESCALE 8
+/* CS high between transactions and CS low before the first SCK edge: at least
+ * 4 FPGA clocks (0.33 us) each, for the slave's synchronisers; 2 us here. */
+#define BOARD_SPI_CS_GAP_US 2u
 
 #define BOARD_RX_IDLE_US 20000u /* firmware inter-byte timeout (docs/protocol.md) */
 

@@ -1,8 +1,8 @@
-/* The FPGA register map over SPI0 (PL022, mode 0, 8-bit frames).
- * Transaction: CS low, command byte (0x80 = read, 0x00 = write), 16-bit word
- * address big-endian, then 4 data bytes little-endian (for a read the FPGA
- * answers in those 4 byte slots after one turnaround byte), CS high. */
+/* The FPGA register map over SPI0 (PL022, mode 0, 8-bit frames), one
+ * transaction per register access with CS low around it; the bytes are
+ * cbvh_fw/spi_wire.h's. */
 #include "board.h"
+#include "cbvh_fw/spi_wire.h"
 #include "port.h"
 #include "rp2040_regs.h"
 
@@ -13,10 +13,16 @@ static uint8_t xfer(uint8_t out) {
     return (uint8_t)SSPDR;
 }
 
+static void wait_us(uint32_t us) {
+    uint32_t t0 = TIMER_TIMERAWL;
+    while (TIMER_TIMERAWL - t0 <= us) {}
+}
+
 static void cs(int active) {
     while (SSPSR & SSPSR_BSY) {}
     if (active) SIO_GPIO_OUT_CLR = 1u << BOARD_PIN_SPI_CS;
     else SIO_GPIO_OUT_SET = 1u << BOARD_PIN_SPI_CS;
+    wait_us(BOARD_SPI_CS_GAP_US);
 }
 
 void board_spi_init(void) {
@@ -35,25 +41,23 @@ void board_spi_init(void) {
     SSPCR1 = 1u << 1; /* SSE */
 }
 
+static void transaction(const uint8_t *out, uint8_t *in, unsigned n) {
+    cs(1);
+    for (unsigned i = 0; i < n; i++) in[i] = xfer(out[i]);
+    cs(0);
+}
+
 uint32_t board_reg_read(void *ctx, uint32_t addr) {
     (void)ctx;
-    cs(1);
-    xfer(0x80);
-    xfer((uint8_t)(addr >> 10));
-    xfer((uint8_t)(addr >> 2));
-    xfer(0); /* turnaround */
-    uint32_t v = 0;
-    for (int i = 0; i < 4; i++) v |= (uint32_t)xfer(0) << (8 * i);
-    cs(0);
-    return v;
+    uint8_t out[CBVH_SPI_READ_BYTES], in[CBVH_SPI_READ_BYTES];
+    cbvh_spi_read_bytes(addr, out);
+    transaction(out, in, CBVH_SPI_READ_BYTES);
+    return cbvh_spi_read_value(in);
 }
 
 void board_reg_write(void *ctx, uint32_t addr, uint32_t value) {
     (void)ctx;
-    cs(1);
-    xfer(0x00);
-    xfer((uint8_t)(addr >> 10));
-    xfer((uint8_t)(addr >> 2));
-    for (int i = 0; i < 4; i++) xfer((uint8_t)(value >> (8 * i)));
-    cs(0);
+    uint8_t out[CBVH_SPI_WRITE_BYTES], in[CBVH_SPI_WRITE_BYTES];
+    cbvh_spi_write_bytes(addr, value, out);
+    transaction(out, in, CBVH_SPI_WRITE_BYTES);
 }

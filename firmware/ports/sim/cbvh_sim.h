@@ -25,6 +25,18 @@ void cbvh_regmap_model_write(void *ctx, uint32_t addr, uint32_t value);
 /* Unit configuration as the datapath decodes the CONFIG register. */
 cbvh_unit_config cbvh_regmap_config(uint32_t config_word);
 
+/* Gateware-backed register map (regmap_gateware.c): the board top's RTL
+ * simulated by Icarus (program built by gateware/scripts/build-board-sim),
+ * driven over SPI byte by byte.  broken_unit as in cbvh_regmap_model. */
+typedef struct cbvh_gateware cbvh_gateware;
+cbvh_gateware *cbvh_gateware_start(const char *program, int broken_unit, char *err, size_t errlen);
+uint32_t cbvh_gateware_read(void *ctx, uint32_t addr);
+void cbvh_gateware_write(void *ctx, uint32_t addr, uint32_t value);
+/* The first failure of the simulation (it ended, hung, answered garbage), or NULL. */
+const char *cbvh_gateware_error(const cbvh_gateware *g);
+uint64_t cbvh_gateware_transactions(const cbvh_gateware *g);
+void cbvh_gateware_stop(cbvh_gateware *g);
+
 /* Board addresses: "unix:PATH", "tcp:HOST:PORT" (PORT 1..65535), or a bare
  * PATH (contains '/').  Returns a connected/listening fd, or with err set
  * CBVH_SIM_BAD_ADDR when the address itself is wrong (syntax, port range, no
@@ -44,10 +56,12 @@ typedef struct {
     cbvh_link_fault *faults;  /* faults on the reply direction, or NULL */
     int verbose;
     int broken_unit;          /* see cbvh_regmap_model.broken_unit */
+    cbvh_gateware *gateware;  /* the FPGA as simulated RTL, or NULL for the model */
 } cbvh_sim_board_opts;
 
 /* Accepts one connection at a time and runs the firmware core on it until
- * *stop.  Returns 0, or -1 on a listening-socket error. */
+ * *stop.  Returns 0, or -1 on a listening-socket error or a failed gateware
+ * simulation (cbvh_gateware_error says why). */
 int cbvh_sim_board_serve(const cbvh_sim_board_opts *o);
 
 #endif

@@ -72,6 +72,7 @@ void cbvh_regmap_model_write(void *ctx, uint32_t addr, uint32_t value) {
                 m->status = CBVH_STAT_DONE | CBVH_STAT_ERROR;
                 break;
             }
+            memset(m->out, 0, sizeof m->out); /* OUT past n_out reads 0, as in the gateware */
             u->eval(&c, m->in, m->out);
             if (m->broken_unit && (int)u->id == m->broken_unit) m->out[0] ^= 1u;
             m->runs++;

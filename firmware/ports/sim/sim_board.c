@@ -1,5 +1,6 @@
 /* The virtual board: the firmware core behind a socket (one connection at a
- * time), with the model-backed register map as its FPGA. */
+ * time), with the model-backed register map or the simulated gateware as its
+ * FPGA. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <netdb.h>
@@ -128,11 +129,19 @@ typedef struct {
 
 typedef struct {
     cbvh_regmap_model regs;
+    cbvh_gateware *gateware;
     sim_conn conn;
 } sim_board;
 
-static uint32_t hal_read(void *ctx, uint32_t addr) { return cbvh_regmap_model_read(&((sim_board *)ctx)->regs, addr); }
-static void hal_write(void *ctx, uint32_t addr, uint32_t v) { cbvh_regmap_model_write(&((sim_board *)ctx)->regs, addr, v); }
+static uint32_t hal_read(void *ctx, uint32_t addr) {
+    sim_board *b = ctx;
+    return b->gateware ? cbvh_gateware_read(b->gateware, addr) : cbvh_regmap_model_read(&b->regs, addr);
+}
+static void hal_write(void *ctx, uint32_t addr, uint32_t v) {
+    sim_board *b = ctx;
+    if (b->gateware) cbvh_gateware_write(b->gateware, addr, v);
+    else cbvh_regmap_model_write(&b->regs, addr, v);
+}
 static void hal_send(void *ctx, const uint8_t *frame, size_t len) {
     sim_conn *c = &((sim_board *)ctx)->conn;
     if (c->broken) return;
@@ -150,6 +159,7 @@ int cbvh_sim_board_serve(const cbvh_sim_board_opts *o) {
     }
     cbvh_regmap_model_init(&board->regs);
     board->regs.broken_unit = o->broken_unit;
+    board->gateware = o->gateware;
     cbvh_fw_hal hal = {board, hal_read, hal_write, hal_send, "cbvh-sim"};
     cbvh_fw_init(fw, &hal);
     int rc = 0;
@@ -185,9 +195,14 @@ int cbvh_sim_board_serve(const cbvh_sim_board_opts *o) {
             if (n <= 0) break;
             idle_ms = 0;
             cbvh_fw_rx(fw, buf, (size_t)n);
+            if (board->gateware && cbvh_gateware_error(board->gateware)) {
+                rc = -1;
+                break;
+            }
         }
         close(fd);
         if (o->verbose) fprintf(stderr, "cbvh board-sim: host disconnected\n");
+        if (rc) break;
     }
     free(board);
     free(fw);
