@@ -128,6 +128,23 @@ static long long now_ms(void) {
     return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
+/* The simulation closed its end of a pipe: report how it ended, waiting up to
+ * 1 s for it to exit (else the pipe error says what happened). */
+static void report_end(cbvh_gateware *g, const char *pipe_error) {
+    int st = 0, reaped = 0;
+    for (int i = 0; i < 100 && !reaped; i++) {
+        reaped = waitpid(g->pid, &st, WNOHANG) == g->pid;
+        if (!reaped) usleep(10000);
+    }
+    if (!reaped) {
+        fail(g, "gateware simulation: %s", pipe_error);
+        return;
+    }
+    g->pid = -1;
+    if (WIFEXITED(st)) fail(g, "gateware simulation ended (exit status %d)", WEXITSTATUS(st));
+    else fail(g, "gateware simulation killed by signal %d", WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+}
+
 /* The next "@ ..." line from the simulation, into line (NUL-terminated). */
 static int read_reply(cbvh_gateware *g, char *line, size_t cap) {
     long long deadline = now_ms() + REPLY_TIMEOUT_MS;
@@ -169,11 +186,7 @@ static int read_reply(cbvh_gateware *g, char *line, size_t cap) {
         ssize_t n = read(g->from_sim, g->buf + g->have, sizeof g->buf - g->have);
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) {
-            int st = 0;
-            waitpid(g->pid, &st, 0);
-            g->pid = -1;
-            if (WIFEXITED(st)) fail(g, "gateware simulation ended (exit status %d)", WEXITSTATUS(st));
-            else fail(g, "gateware simulation killed by signal %d", WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+            report_end(g, n < 0 ? strerror(errno) : "it closed its output");
             return -1;
         }
         g->have += (size_t)n;
@@ -191,7 +204,9 @@ static int transaction(cbvh_gateware *g, const uint8_t *out, uint8_t *in, unsign
         ssize_t w = write(g->to_sim, req + done, (size_t)(len - done));
         if (w < 0 && errno == EINTR) continue;
         if (w <= 0) {
-            fail(g, "gateware simulation: cannot send a transaction: %s", strerror(errno));
+            char why[128];
+            snprintf(why, sizeof why, "cannot send a transaction: %s", strerror(errno));
+            report_end(g, why);
             return -1;
         }
         done += (int)w;
