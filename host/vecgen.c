@@ -1583,6 +1583,26 @@ static void reject_combinations_ray_sphere(gen_t *g) {
         cbvh_f32 r = (k & 8) ? 0xBF800000u /* -1 */ : F_ONE;
         emit_ray_sphere(g, o, d, tmin, tmax, c, r);
     }
+    /* Generator 4, after a clean-room RTL (docs/gateware.md): neither reading
+     * below was pinned by a level-1 vector.  (1) A segment's ends compare as
+     * values, -0 = +0: [+0, -0] and [-0, +0] are the point t = 0, not empty;
+     * the origin is inside the ball, on its surface, or outside it.  (2) The
+     * status does not depend on the segment: every fault with an empty segment
+     * [2, 1], next to the valid ray with it (hit 0, status 0). */
+    const cbvh_f32 zeros[][2] = {{0, CBVH_F32_SIGN}, {CBVH_F32_SIGN, 0}, {CBVH_F32_SIGN, CBVH_F32_SIGN}};
+    const cbvh_f32 centre_z[] = {0xBF000000u /* -0.5: o inside */, F_ONE /* on the surface */,
+                                 0x40000000u /* 2: outside */};
+    for (size_t z = 0; z < sizeof zeros / sizeof zeros[0]; z++)
+        for (size_t i = 0; i < sizeof centre_z / sizeof centre_z[0]; i++) {
+            cbvh_f32 o[3] = {0, 0, 0}, d[3] = {0, 0, F_ONE}, c[3] = {0, 0, centre_z[i]};
+            emit_ray_sphere(g, o, d, zeros[z][0], zeros[z][1], c, F_ONE);
+        }
+    for (int k = 0; k < 5; k++) {
+        cbvh_f32 o[3] = {k == 1 ? F_QNAN : 0, 0, 0xC0000000u}, d[3] = {0, 0, k == 2 ? 0 : F_ONE};
+        cbvh_f32 c[3] = {0, k == 3 ? pinf : 0, 0};
+        cbvh_f32 r = k == 4 ? 0xBF800000u : F_ONE;
+        emit_ray_sphere(g, o, d, 0x40000000u /* 2 */, F_ONE, c, r);
+    }
 }
 
 static void reject_combinations_encode_pair(gen_t *g) { reject_combinations_nodepair(g, 0); }

@@ -105,4 +105,20 @@ module fpga_top_ray_box (input wire clk, input wire din, input wire load, input 
         .out_bits({hit, t_near, t_far, status}), .in_bits(in_sr), .dout(dout));
 endmodule
 
+module fpga_top_ray_sphere (input wire clk, input wire din, input wire load, input wire start,
+                            input wire rst, output wire dout, output wire busy, output wire done);
+    localparam integer IN_W = 12 * 32, OUT_W = 1 + 8;
+    wire [IN_W-1:0] in_sr;
+    wire hit;
+    wire [7:0] status;
+    cbvh_ray_sphere unit (
+        .clk(clk), .rst(rst), .start(start), .busy(busy), .done(done),
+        .ox(in_sr[31:0]), .oy(in_sr[63:32]), .oz(in_sr[95:64]), .dx(in_sr[127:96]),
+        .dy(in_sr[159:128]), .dz(in_sr[191:160]), .tmin(in_sr[223:192]), .tmax(in_sr[255:224]),
+        .cx(in_sr[287:256]), .cy(in_sr[319:288]), .cz(in_sr[351:320]), .r(in_sr[383:352]),
+        .hit(hit), .status(status));
+    fpga_shift_io #(.IN_W(IN_W), .OUT_W(OUT_W)) io (.clk(clk), .din(din), .load(load),
+        .out_bits({hit, status}), .in_bits(in_sr), .dout(dout));
+endmodule
+
 `default_nettype wire
