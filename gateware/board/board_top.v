@@ -20,7 +20,8 @@ module cbvh_board_top #(
     parameter integer HAS_NP_ENCODER = 1,
     parameter integer HAS_NP_DECODER = 1,
     parameter integer HAS_RAY_BOX    = 1,
-    parameter integer HAS_QBVH_STACK = 1
+    parameter integer HAS_QBVH_STACK = 1,
+    parameter integer HAS_RAY_SPHERE = 1   // unit 9 (sequential, as the ray box)
 ) (
     input  wire clk,
     input  wire spi_sck,
@@ -49,7 +50,7 @@ module cbvh_board_top #(
         .HAS_ESTIMATOR(HAS_ESTIMATOR), .HAS_COMPRESSOR(HAS_COMPRESSOR),
         .HAS_DECODER(HAS_DECODER), .HAS_NP_ENCODER(HAS_NP_ENCODER),
         .HAS_NP_DECODER(HAS_NP_DECODER), .HAS_RAY_BOX(HAS_RAY_BOX),
-        .HAS_QBVH_STACK(HAS_QBVH_STACK)
+        .HAS_QBVH_STACK(HAS_QBVH_STACK), .HAS_RAY_SPHERE(HAS_RAY_SPHERE)
     ) u_regs (
         .clk(clk), .rst(rst),
         .wr_en(wr_en), .wr_addr(wr_addr), .wr_data(wr_data),

@@ -16,7 +16,7 @@
 // A unit accepts CONFIG when it is built and, for units 1-5, CONFIG's N and
 // min_scale equal the parameters N and E_MIN; for units 3-5 the encoding of
 // CONFIG[24] must also be built (ENCODINGS bit 0 modulo, bit 1 relative).
-// Units 6 (ray box) and 8 (QBVH stack) accept any CONFIG.
+// Units 6 (ray box), 8 (QBVH stack) and 9 (ray sphere) accept any CONFIG.
 //
 // Start of a combinational unit: STATUS = done and OUT latches the unit's
 // outputs one clock after the CTRL write, then keeps re-latching them for
@@ -28,8 +28,10 @@
 // at least 56 SCK periods (>= 448 clk) later. So the paths IN -> unit -> OUT
 // are multicycle paths, and the design's nextpnr fmax (which counts them as
 // single-cycle) understates what it runs at.
-// Start of the ray box: its start is pulsed, STATUS = busy until its done,
-// then OUT latches its (registered) outputs and STATUS = done.
+// Start of a sequential unit (6 ray box, 9 ray sphere): its start is pulsed
+// and which unit runs is latched, STATUS = busy until that unit's done, then
+// OUT latches its (registered) outputs and STATUS = done. A UNIT_SEL write
+// during the run does not change what OUT captures; CTRL reset aborts the run.
 `default_nettype none
 
 /* verilator lint_off DECLFILENAME */ // file name is fixed by the project layout
@@ -43,7 +45,8 @@ module cbvh_datapath_regs #(
     parameter integer HAS_NP_ENCODER = 1,    // unit 4 nodepair_encode
     parameter integer HAS_NP_DECODER = 1,    // unit 5 nodepair_decode
     parameter integer HAS_RAY_BOX    = 1,    // unit 6 ray_box
-    parameter integer HAS_QBVH_STACK = 1     // unit 8 qbvh_stack
+    parameter integer HAS_QBVH_STACK = 1,    // unit 8 qbvh_stack
+    parameter integer HAS_RAY_SPHERE = 1     // unit 9 ray_sphere
 ) (
     input  wire        clk,
     input  wire        rst,      // synchronous, active high
@@ -67,8 +70,9 @@ module cbvh_datapath_regs #(
     localparam integer B5 = (HAS_NP_DECODER != 0 && (ENC_MOD + ENC_REL) != 0) ? 1 : 0;
     localparam integer B6 = (HAS_RAY_BOX != 0) ? 1 : 0;
     localparam integer B8 = (HAS_QBVH_STACK != 0) ? 1 : 0;
+    localparam integer B9 = (HAS_RAY_SPHERE != 0) ? 1 : 0;
     localparam [31:0] UNITS_MASK = (B1 << 1) | (B2 << 2) | (B3 << 3) | (B4 << 4) |
-                                   (B5 << 5) | (B6 << 6) | (B8 << 8);
+                                   (B5 << 5) | (B6 << 6) | (B8 << 8) | (B9 << 9);
 
     // shapes (rtl-model/src/unit_table.c): input and output words per unit
     localparam integer NIN1 = 2,  NOUT1 = 2;
@@ -78,6 +82,7 @@ module cbvh_datapath_regs #(
     localparam integer NIN5 = (N <= 6) ? 16 : 18, NOUT5 = 35;
     localparam integer NIN6 = 21, NOUT6 = 4;
     localparam integer NIN8 = 8,  NOUT8 = 6;
+    localparam integer NIN9 = 12, NOUT9 = 2;
 
     function integer max2;
         input integer a, b;
@@ -87,10 +92,10 @@ module cbvh_datapath_regs #(
     // (at least one, so that no vector has width zero)
     localparam integer IN_WORDS =
         max2(1, max2(max2(max2(B1 * NIN1, B2 * NIN2), max2(B3 * NIN3, B4 * NIN4)),
-                     max2(max2(B5 * NIN5, B6 * NIN6), B8 * NIN8)));
+                     max2(max2(B5 * NIN5, B6 * NIN6), max2(B8 * NIN8, B9 * NIN9))));
     localparam integer OUT_WORDS =
         max2(1, max2(max2(max2(B1 * NOUT1, B2 * NOUT2), max2(B3 * NOUT3, B4 * NOUT4)),
-                     max2(max2(B5 * NOUT5, B6 * NOUT6), B8 * NOUT8)));
+                     max2(max2(B5 * NOUT5, B6 * NOUT6), max2(B8 * NOUT8, B9 * NOUT9))));
 
     localparam [31:0] N_W = N;          // 32-bit copies to take the field bits from
     localparam [31:0] E_MIN_W = E_MIN;
@@ -116,7 +121,9 @@ module cbvh_datapath_regs #(
     reg  [OUT_WORDS*32-1:0] out_w;      // OUT[i] = out_w[32i +: 32]
     reg                     start_req;  // a CTRL start, handled the clock after the write
     reg  [3:0]              recap;      // re-captures of a combinational unit still to do
-    reg                     rb_run;     // the ray box is running
+    // the sequential unit that runs (one-hot), latched at its start so that a
+    // UNIT_SEL write during the run cannot redirect the capture
+    reg                     run6, run9;
 
     wire ctrl_wr    = wr_en && (wr_addr == A_CTRL);
     wire ctrl_reset = ctrl_wr && wr_data[1];
@@ -126,7 +133,7 @@ module cbvh_datapath_regs #(
     wire rel    = config_r[24];
     wire enc_ok = rel ? (ENC_REL != 0) : (ENC_MOD != 0);
     // UNIT_SEL decoded when written (one id at a time; 0 for any other value)
-    reg  sel1, sel2, sel3, sel4, sel5, sel6, sel8;
+    reg  sel1, sel2, sel3, sel4, sel5, sel6, sel8, sel9;
     wire acc1 = (B1 != 0) && cfg_ok;
     wire acc2 = (B2 != 0) && cfg_ok;
     wire acc3 = (B3 != 0) && cfg_ok && enc_ok;
@@ -134,24 +141,26 @@ module cbvh_datapath_regs #(
     wire acc5 = (B5 != 0) && cfg_ok && enc_ok;
     wire acc6 = (B6 != 0);
     wire acc8 = (B8 != 0);
+    wire acc9 = (B9 != 0);
     wire sel_acc = (sel1 && acc1) || (sel2 && acc2) || (sel3 && acc3) || (sel4 && acc4) ||
-                   (sel5 && acc5) || (sel6 && acc6) || (sel8 && acc8);
+                   (sel5 && acc5) || (sel6 && acc6) || (sel8 && acc8) || (sel9 && acc9);
+    wire sel_seq = (sel6 && acc6) || (sel9 && acc9);   // a built sequential unit is selected
 
     // {n_out, n_in} of each unit, as 32-bit constants
     localparam [31:0] SH1 = NOUT1 * 256 + NIN1, SH2 = NOUT2 * 256 + NIN2,
                       SH3 = NOUT3 * 256 + NIN3, SH4 = NOUT4 * 256 + NIN4,
                       SH5 = NOUT5 * 256 + NIN5, SH6 = NOUT6 * 256 + NIN6,
-                      SH8 = NOUT8 * 256 + NIN8;
+                      SH8 = NOUT8 * 256 + NIN8, SH9 = NOUT9 * 256 + NIN9;
     wire [31:0] shape_u = ({32{sel1}} & SH1) | ({32{sel2}} & SH2) | ({32{sel3}} & SH3) |
                           ({32{sel4}} & SH4) | ({32{sel5}} & SH5) | ({32{sel6}} & SH6) |
-                          ({32{sel8}} & SH8);
+                          ({32{sel8}} & SH8) | ({32{sel9}} & SH9);
     wire [31:0] shape = sel_acc ? shape_u : 32'd0;
 
     // ------------------------------------------------------------------- units
     // Each built unit's outputs as OUT_WORDS zero-extended words; unbuilt: zero.
     wire [OUT_WORDS*32-1:0] u1_bus, u2_bus, u3_bus, u4_bus, u5_bus, u8_bus;
-    wire [OUT_WORDS*32-1:0] rb_bus;
-    wire                    rb_done;
+    wire [OUT_WORDS*32-1:0] rb_bus, rs_bus;
+    wire                    rb_done, rs_done;
 
     // a start is handled the clock after its CTRL write, after the reset of
     // the same write has zeroed IN (as the C model: reset, then start); a
@@ -257,6 +266,27 @@ module cbvh_datapath_regs #(
         end else begin : g_no_qbvh
             assign u8_bus = {OUT_WORDS*32{1'b0}};
         end
+
+        if (B9 != 0) begin : g_rs
+            wire        busy_unused;  // STATUS.busy is kept here, from start to done
+            wire        rs_start = start_go && sel9 && acc9;
+            wire        rs_rst   = rst || ctrl_reset;   // CTRL reset aborts a run
+            wire        hit;
+            wire [7:0]  st;
+            cbvh_ray_sphere u_rs (
+                .clk(clk), .rst(rs_rst), .start(rs_start), .busy(busy_unused), .done(rs_done),
+                .ox(in_w[0*32 +: 32]), .oy(in_w[1*32 +: 32]), .oz(in_w[2*32 +: 32]),
+                .dx(in_w[3*32 +: 32]), .dy(in_w[4*32 +: 32]), .dz(in_w[5*32 +: 32]),
+                .tmin(in_w[6*32 +: 32]), .tmax(in_w[7*32 +: 32]),
+                .cx(in_w[8*32 +: 32]), .cy(in_w[9*32 +: 32]), .cz(in_w[10*32 +: 32]),
+                .r(in_w[11*32 +: 32]),
+                .hit(hit), .status(st));
+            wire [NOUT9*32-1:0] o = {{24'd0, st}, {31'd0, hit}};
+            cbvh_board_pad #(.NW(NOUT9), .OW(OUT_WORDS)) u_pad (.o(o), .bus(rs_bus));
+        end else begin : g_no_rs
+            assign rs_bus  = {OUT_WORDS*32{1'b0}};
+            assign rs_done = 1'b0;
+        end
     endgenerate
 
     // the selected combinational unit's outputs (UNIT_SEL is one id at a time)
@@ -282,7 +312,7 @@ module cbvh_datapath_regs #(
         if (rst) begin
             config_r <= 32'd0;
             unit_sel <= 32'd0;
-            {sel1, sel2, sel3, sel4, sel5, sel6, sel8} <= 7'd0;
+            {sel1, sel2, sel3, sel4, sel5, sel6, sel8, sel9} <= 8'd0;
         end else if (wr_en) begin
             if (wr_addr == A_CONFIG) config_r <= wr_data;
             if (wr_addr == A_UNIT_SEL) begin
@@ -294,34 +324,39 @@ module cbvh_datapath_regs #(
                 sel5 <= (wr_data == 32'd5);
                 sel6 <= (wr_data == 32'd6);
                 sel8 <= (wr_data == 32'd8);
+                sel9 <= (wr_data == 32'd9);
             end
         end
     end
 
     // OUT latches a combinational unit's outputs (start, then re-captures)
-    // or the ray box's when it is done
-    wire cap_rb   = rb_run && rb_done;
-    wire cap_comb = (start_go && sel_acc && !sel6) || (recap != 4'd0);
+    // or, when its done pulses, those of the sequential unit that was started
+    wire cap_seq  = (run6 && rb_done) || (run9 && rs_done);
+    wire cap_comb = (start_go && sel_acc && !sel_seq) || (recap != 4'd0);
+    wire [OB-1:0] seq_bus = ({OB{run6}} & rb_bus) | ({OB{run9}} & rs_bus);
 
     always @(posedge clk) begin
         start_req <= !rst && ctrl_wr && wr_data[0];
         if (rst || ctrl_reset) begin
             status <= 3'd0;
             recap  <= 4'd0;
-            rb_run <= 1'b0;
+            run6   <= 1'b0;
+            run9   <= 1'b0;
         end else begin
             if (recap != 4'd0)
                 recap <= recap - 4'd1;
-            if (cap_rb) begin
+            if (cap_seq) begin
                 status <= ST_DONE;
-                rb_run <= 1'b0;
+                run6   <= 1'b0;
+                run9   <= 1'b0;
             end
             if (start_go) begin
                 if (!sel_acc) begin
                     status <= ST_DONE | ST_ERROR;  // OUT unchanged, as the C model
-                end else if (sel6) begin
-                    status <= ST_BUSY;             // rb_start pulses now
-                    rb_run <= 1'b1;
+                end else if (sel_seq) begin
+                    status <= ST_BUSY;             // the unit's start pulses now
+                    run6   <= sel6;
+                    run9   <= sel9;
                 end else begin
                     status <= ST_DONE;
                     recap  <= RECAPTURE;
@@ -334,8 +369,8 @@ module cbvh_datapath_regs #(
     always @(posedge clk) begin
         if (rst || ctrl_reset)
             out_w <= {OUT_WORDS*32{1'b0}};
-        else if (cap_rb || cap_comb)
-            out_w <= cap_rb ? rb_bus : comb_bus;
+        else if (cap_seq || cap_comb)
+            out_w <= cap_seq ? seq_bus : comb_bus;
     end
 
     // ----------------------------------------------------------------- reads

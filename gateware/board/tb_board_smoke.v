@@ -4,11 +4,13 @@
 // the fastest SCK the slave supports (high and low phases of 4 clk), with its
 // edges offset from clk's. It checks ID, VERSION, UNITS, CONFIG and UNIT_SEL
 // readback, SHAPE of every unit id, the first vector lines of
-// axis_compress / ray_box / qbvh_stack -N6-ms-30.vec (plus their second lines)
-// through IN, CTRL, STATUS and OUT, that OUT is latched, CTRL reset, start on
-// an unbuilt or unaccepted unit, unknown addresses, a bad command byte, and
-// transactions cut short by CS high or run past 7 bytes. $fatal on any
-// mismatch; "tb_board_smoke: PASS" at the end.
+// axis_compress / ray_box / qbvh_stack / ray_sphere -N6-ms-30.vec (plus their
+// second lines) through IN, CTRL, STATUS and OUT, that OUT is latched, CTRL
+// reset (also aborting a sequential unit), that a UNIT_SEL write while the
+// ray sphere runs does not change what OUT captures, start on an unbuilt or
+// unaccepted unit, unknown addresses, a bad command byte, and transactions
+// cut short by CS high or run past 7 bytes. $fatal on any mismatch;
+// "tb_board_smoke: PASS" at the end.
 //   iverilog -g2005 -s tb_board_smoke -o tb.vvp gateware/board/*.v gateware/rtl/*.v && vvp tb.vvp
 //   (-P tb_board_smoke.HAS_RAY_BOX=0 etc.: unbuilt units vanish from UNITS and SHAPE)
 `default_nettype none
@@ -22,6 +24,7 @@ module tb_board_smoke;
     parameter integer HAS_NP_DECODER = 1;
     parameter integer HAS_RAY_BOX    = 1;
     parameter integer HAS_QBVH_STACK = 1;
+    parameter integer HAS_RAY_SPHERE = 1;
     parameter integer HALF           = 40;   // SCK half period; clk period 10
     parameter integer PHASE          = 3;    // SCK edges this far after a clk edge
 
@@ -38,9 +41,10 @@ module tb_board_smoke;
                        B3 = HAS_DECODER != 0 && ENCODINGS % 4 != 0,
                        B4 = HAS_NP_ENCODER != 0 && ENCODINGS % 4 != 0,
                        B5 = HAS_NP_DECODER != 0 && ENCODINGS % 4 != 0,
-                       B6 = HAS_RAY_BOX != 0, B8 = HAS_QBVH_STACK != 0;
+                       B6 = HAS_RAY_BOX != 0, B8 = HAS_QBVH_STACK != 0,
+                       B9 = HAS_RAY_SPHERE != 0;
     localparam [31:0] UNITS_EXP = (B1 << 1) | (B2 << 2) | (B3 << 3) | (B4 << 4) | (B5 << 5) |
-                                  (B6 << 6) | (B8 << 8);
+                                  (B6 << 6) | (B8 << 8) | (B9 << 9);
 
     reg  clk = 1'b0;
     always #5 clk = ~clk;
@@ -51,7 +55,8 @@ module tb_board_smoke;
         .N(6), .E_MIN(-30), .ENCODINGS(ENCODINGS),
         .HAS_ESTIMATOR(HAS_ESTIMATOR), .HAS_COMPRESSOR(HAS_COMPRESSOR), .HAS_DECODER(HAS_DECODER),
         .HAS_NP_ENCODER(HAS_NP_ENCODER), .HAS_NP_DECODER(HAS_NP_DECODER),
-        .HAS_RAY_BOX(HAS_RAY_BOX), .HAS_QBVH_STACK(HAS_QBVH_STACK)
+        .HAS_RAY_BOX(HAS_RAY_BOX), .HAS_QBVH_STACK(HAS_QBVH_STACK),
+        .HAS_RAY_SPHERE(HAS_RAY_SPHERE)
     ) dut (.clk(clk), .spi_sck(sck), .spi_cs_n(cs_n), .spi_mosi(mosi), .spi_miso(miso));
 
     // reference: the compressor on all-zero inputs (for CTRL = reset | start)
@@ -189,7 +194,7 @@ module tb_board_smoke;
     // ------------------------------------------------------------- vectors
     reg [31:0] vin  [0:20];
     reg [31:0] vout [0:5];
-    integer i, nin, nout, u;
+    integer i, nin, nout, u, npolls;
     reg [31:0] v, shp;
 
     task run_vector;   // IN[0..nin) = vin, start, OUT[0..nout) == vout, OUT[nout..] 0
@@ -217,6 +222,7 @@ module tb_board_smoke;
                 5: shape_exp = (B5 && ok && enc) ? 32'h2310 : 0;
                 6: shape_exp = B6 ? 32'h0415 : 0;
                 8: shape_exp = B8 ? 32'h0608 : 0;
+                9: shape_exp = B9 ? 32'h020C : 0;
                 default: shape_exp = 0;
             endcase
         end
@@ -241,8 +247,8 @@ module tb_board_smoke;
         expect_reg("VERSION", R_VERSION, 32'd1);
         expect_reg("UNITS", R_UNITS, UNITS_EXP);
         if (ENCODINGS == 1 && HAS_ESTIMATOR && HAS_COMPRESSOR && HAS_DECODER && HAS_NP_ENCODER &&
-            HAS_NP_DECODER && HAS_RAY_BOX && HAS_QBVH_STACK)
-            check("UNITS, all built", UNITS_EXP, 32'h17E);
+            HAS_NP_DECODER && HAS_RAY_BOX && HAS_QBVH_STACK && HAS_RAY_SPHERE)
+            check("UNITS, all built", UNITS_EXP, 32'h37E);
         expect_reg("STATUS after power-on", R_STATUS, 32'd0);
 
         // rw registers keep all 32 bits; read-only and unknown addresses
@@ -357,6 +363,61 @@ module tb_board_smoke;
             run_vector;
             vin[2] = 32'h1;
             vout[0] = 32'h00000005; vout[4] = 32'h1;
+            run_vector;
+        end else begin
+            run(32'd6);
+        end
+
+        // ray_sphere-N6-ms-30.vec, lines 1 (a hit) and 2 (a miss); CONFIG is
+        // still the wrong N: the sphere accepts any CONFIG
+        reg_write(R_CTRL, 32'd2);
+        reg_write(R_UNIT_SEL, 32'd9);
+        if (B9) begin
+            nin = 12; nout = 2;
+            vin[0] = 32'hC0A00000; vin[1] = 32'h00000000; vin[2] = 32'h00000000;
+            vin[3] = 32'h3F800000; vin[4] = 32'h00000000; vin[5] = 32'h00000000;
+            vin[6] = 32'h00000000; vin[7] = 32'h7F800000;
+            vin[8] = 32'h00000000; vin[9] = 32'h00000000; vin[10] = 32'h00000000;
+            vin[11] = 32'h3F800000;
+            vout[0] = 32'd1; vout[1] = 32'h00;
+            for (i = 0; i < nin; i = i + 1) reg_write(32'h100 + 4 * i, vin[i]);
+            reg_write(R_CTRL, 32'd1);
+            check("STATUS busy after ray-sphere start", {29'd0, dut.u_regs.status}, 32'd1);
+            run_vector;
+            vin[3] = 32'hBF800000;
+            vout[0] = 32'd0;
+            run_vector;
+            // line 745 takes 722 clocks, longer than the SPI write of UNIT_SEL
+            // = 6 that follows its start: OUT still captures the sphere's hit
+            vin[0] = 32'h0000B600; vin[1] = 32'h00018A00; vin[2] = 32'h00023000;
+            vin[3] = 32'h2C000000; vin[4] = 32'h2C400000; vin[5] = 32'h2CC00000;
+            vin[6] = 32'h00000000; vin[7] = 32'h0E400000;
+            vin[8] = 32'h0000C800; vin[9] = 32'h00019000; vin[10] = 32'h00025800;
+            vin[11] = 32'h00000E00;
+            for (i = 0; i < nin; i = i + 1) reg_write(32'h100 + 4 * i, vin[i]);
+            reg_write(R_CTRL, 32'd1);
+            reg_write(R_UNIT_SEL, 32'd6);
+            check("STATUS busy after UNIT_SEL write", {29'd0, dut.u_regs.status}, 32'd1);
+            npolls = 0;
+            reg_read(R_STATUS, v);
+            while (v[0] && npolls < 1000) begin
+                npolls = npolls + 1;
+                reg_read(R_STATUS, v);
+            end
+            check("STATUS after a re-selected run", v, 32'd2);
+            expect_reg("OUT0 after re-select (hit)", 32'h200, 32'd1);
+            expect_reg("OUT1 after re-select (status)", 32'h204, 32'd0);
+            expect_reg("OUT2 after re-select", 32'h208, 32'd0);
+            expect_reg("OUT3 after re-select", 32'h20C, 32'd0);
+            // CTRL reset aborts a sphere run: STATUS 0, OUT 0; then it runs again
+            reg_write(R_UNIT_SEL, 32'd9);
+            for (i = 0; i < nin; i = i + 1) reg_write(32'h100 + 4 * i, vin[i]);
+            reg_write(R_CTRL, 32'd1);
+            check("STATUS busy before the abort", {29'd0, dut.u_regs.status}, 32'd1);
+            reg_write(R_CTRL, 32'd2);
+            expect_reg("STATUS after sphere abort", R_STATUS, 32'd0);
+            expect_reg("OUT0 after sphere abort", 32'h200, 32'd0);
+            vout[0] = 32'd1; vout[1] = 32'h00;
             run_vector;
         end else begin
             run(32'd6);

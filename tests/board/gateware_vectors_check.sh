@@ -46,7 +46,7 @@ board() { # board [extra board-sim options]
 
 # Every unit with RTL at the built design point (N = 6, min scale -30, both encodings).
 files=""
-for u in scale_estimate axis_compress axis_decode nodepair_encode nodepair_decode ray_box qbvh_stack; do
+for u in scale_estimate axis_compress axis_decode nodepair_encode nodepair_decode ray_box ray_sphere qbvh_stack; do
     for f in "$vec"/$u-N6-ms-30.vec "$vec"/$u-N6-ms-30-*.vec; do
         case $f in *-L2.vec) continue ;; esac
         [ -f "$f" ] && files="$files $f"
