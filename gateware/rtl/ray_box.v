@@ -65,13 +65,6 @@ module cbvh_ray_box (
         end
     endfunction
 
-    function is_naninf;     // exponent field all ones
-        input [7:0] ef;
-        begin
-            is_naninf = &ef;
-        end
-    endfunction
-
     function is_nan;
         input [30:0] f;
         begin
@@ -87,9 +80,9 @@ module cbvh_ray_box (
     endfunction
 
     // ---------------------------------------------------------------- status
-    wire ray_bad    = is_naninf(ox[30:23]) | is_naninf(oy[30:23]) | is_naninf(oz[30:23]) |
-                      is_naninf(dx[30:23]) | is_naninf(dy[30:23]) | is_naninf(dz[30:23]) |
-                      is_naninf(tmin[30:23]) | is_nan(tmax[30:0]) | (tmax == 32'hFF800000);
+    wire ray_bad, st_zero_dir;
+    cbvh_ray_check u_ray (.ox(ox), .oy(oy), .oz(oz), .dx(dx), .dy(dy), .dz(dz), .tmin(tmin), .tmax(tmax),
+                          .nan_inf(ray_bad), .zero_dir(st_zero_dir));
     wire st_nan_inf = ray_bad |
                       is_nan(x_u[30:0]) | (x_u == 32'h7F800000) |
                       is_nan(y_u[30:0]) | (y_u == 32'h7F800000) |
@@ -102,9 +95,8 @@ module cbvh_ray_box (
     wire st_bad_param = (mant < 8'd3) | (mant > 8'd24);
     wire st_bad_code = (x_r > 12'd1024) | (x_s > 12'd1024) | (y_r > 12'd1024) |
                        (y_s > 12'd1024) | (z_r > 12'd1024) | (z_s > 12'd1024);
-    // §3: ZERO_DIR only for a ray without NaN/Inf (its check comes after the
-    // ray's NaN/Inf check); every other applicable bit is ORed
-    wire st_zero_dir = ~ray_bad & (dx[30:0] == 31'd0) & (dy[30:0] == 31'd0) & (dz[30:0] == 31'd0);
+    // §3: ZERO_DIR only for a ray without NaN/Inf (cbvh_ray_check); every
+    // other applicable bit is ORed
     wire [7:0] st_all = {st_zero_dir, 2'b00, st_bad_code, st_bad_param,
                          st_bad_scale, st_inverted, st_nan_inf};
 
@@ -375,4 +367,26 @@ module cbvh_ray_box (
             endcase
         end
     end
+endmodule
+
+// The ray's own rejects, one rule for the ray-box and ray-sphere units
+// (traversal.md §3, §10.2): NaN/Inf in o, d or tmin, NaN or -Inf in tmax
+// (+Inf is an unbounded ray); a zero direction (components +-0) only for a
+// ray without NaN/Inf.
+/* verilator lint_off DECLFILENAME */ // shared by two units, kept with the first
+module cbvh_ray_check (
+    // whole binary32 words, as on every port; the check reads only some fields
+    /* verilator lint_off UNUSEDSIGNAL */
+    input  wire [31:0] ox, oy, oz,
+    input  wire [31:0] dx, dy, dz,
+    input  wire [31:0] tmin, tmax,
+    /* verilator lint_on UNUSEDSIGNAL */
+    output wire        nan_inf,
+    output wire        zero_dir
+);
+/* verilator lint_on DECLFILENAME */
+    assign nan_inf = (&ox[30:23]) | (&oy[30:23]) | (&oz[30:23]) |
+                     (&dx[30:23]) | (&dy[30:23]) | (&dz[30:23]) | (&tmin[30:23]) |
+                     ((&tmax[30:23]) & (|tmax[22:0])) | (tmax == 32'hFF800000);
+    assign zero_dir = ~nan_inf & (dx[30:0] == 31'd0) & (dy[30:0] == 31'd0) & (dz[30:0] == 31'd0);
 endmodule

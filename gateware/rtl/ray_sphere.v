@@ -87,23 +87,15 @@ module cbvh_ray_sphere (
         end
     endfunction
 
-    function is_nan;
-        input [30:0] f;
-        begin
-            is_nan = (&f[30:23]) & (|f[22:0]);
-        end
-    endfunction
-
     // ---------------------------------------------------------------- status
     // §10.2: NAN_INF (bit 0) for the ray, BAD_PARAM (bit 3) for c and r,
     // ZERO_DIR (bit 7) only for a ray without NaN/Inf; bits ORed
-    wire ray_bad = is_naninf(ox[30:23]) | is_naninf(oy[30:23]) | is_naninf(oz[30:23]) |
-                   is_naninf(dx[30:23]) | is_naninf(dy[30:23]) | is_naninf(dz[30:23]) |
-                   is_naninf(tmin[30:23]) | is_nan(tmax[30:0]) | (tmax == 32'hFF800000);
+    wire ray_bad, st_zero_dir;
+    cbvh_ray_check u_ray (.ox(ox), .oy(oy), .oz(oz), .dx(dx), .dy(dy), .dz(dz), .tmin(tmin), .tmax(tmax),
+                          .nan_inf(ray_bad), .zero_dir(st_zero_dir));
     wire st_bad_param = is_naninf(cx[30:23]) | is_naninf(cy[30:23]) | is_naninf(cz[30:23]) |
                         is_naninf(r[30:23]) |
                         (r[31] & (r[30:0] != 31'd0));
-    wire st_zero_dir = ~ray_bad & (dx[30:0] == 31'd0) & (dy[30:0] == 31'd0) & (dz[30:0] == 31'd0);
     wire [7:0] st_all = {st_zero_dir, 3'b000, st_bad_param, 2'b00, ray_bad};
     wire empty_seg = fkey(tmin) > fkey(tmax);
     wire tmax_inf  = (tmax == 32'h7F800000);
