@@ -1,6 +1,8 @@
 /* Embree 3 as the benchmarks' baseline (bench_traverse, bench_wide): one
  * single-threaded device, optionally limited to one instruction set, a scene
- * of the same triangles (RTC_BUILD_QUALITY_HIGH), and timed single-ray
+ * of the same triangles (RTC_BUILD_QUALITY_HIGH; optionally in Embree's robust
+ * mode, RTC_SCENE_FLAG_ROBUST: conservative box tests and watertight
+ * triangle tests, the like-for-like baseline of an exact tracer), and timed single-ray
  * queries over the same rays.  Include after bench_rays.h, and only with
  * CBVH_HAVE_EMBREE. */
 #ifndef CBVH_BENCH_EMBREE_H
@@ -18,8 +20,9 @@ static inline RTCDevice embree_device(const char *isa) {
     return dev;
 }
 
-static inline RTCScene embree_scene(RTCDevice dev, const cbvh_scene *s) {
+static inline RTCScene embree_scene(RTCDevice dev, const cbvh_scene *s, int robust) {
     RTCScene sc = rtcNewScene(dev);
+    if (robust) rtcSetSceneFlags(sc, RTC_SCENE_FLAG_ROBUST);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
                                         (size_t)s->ntris * 3);

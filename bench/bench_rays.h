@@ -52,13 +52,15 @@ static inline int int_option(int argc, char **argv, int *i, const char *name, in
 }
 
 /* The command line of the traversal-vs-Embree benches:
- *   [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]
- * (isa: Embree's isa= setting; NULL = Embree's own choice).  Exits 2 with the
+ *   [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]
+ * (isa: Embree's isa= setting; NULL = Embree's own choice; robust: Embree's
+ * scene flag RTC_SCENE_FLAG_ROBUST, its watertight mode).  Exits 2 with the
  * usage on an unknown option, 1 on a bad value; no scene = the bundled bunny. */
 typedef struct {
     int nrays, reps;
     uint64_t seed;
     const char *isa;
+    int robust;
     const char *specs[64];
     int ns;
 } bench_args;
@@ -76,8 +78,11 @@ static inline void bench_parse(int argc, char **argv, bench_args *a, const char 
             int ok = 0;
             for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) ok |= !strcmp(a->isa, known[k]);
             if (!ok) die("--embree-isa", "must be sse2, sse4.2, avx, avx2 or avx512");
+        } else if (!strcmp(argv[i], "--embree-robust")) {
+            a->robust = 1;
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: " BENCH_NAME " [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]\n");
+            fprintf(stderr, "usage: " BENCH_NAME
+                            " [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]\n");
             exit(2);
         } else if (a->ns < 64) {
             a->specs[a->ns++] = argv[i];

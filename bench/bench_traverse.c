@@ -7,7 +7,7 @@
  *   - the bit-exact CBVH traversal (N = 6 modulo, M = 24),
  * closest hit and any hit, one core, as ratios to Embree.
  *
- * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]
+ * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]
  *   SCENE as for `cbvh study` (mesh file or proc:NAME[:SIZE]); default: the
  *   bundled bunny.  R rays per kind (default 20000): camera rays (pinhole, a
  *   square image looking at the scene centre from outside its box) and random
@@ -18,7 +18,9 @@
  * calling thread for every tracer.  --embree-isa limits Embree to one
  * instruction set (Embree's "isa=" setting: sse2, sse4.2, avx, avx2, avx512);
  * by default it picks the widest the CPU has, while our code is built for the
- * x86-64 baseline (SSE2), so sse2 compares like with like. */
+ * x86-64 baseline (SSE2), so sse2 compares like with like.  --embree-robust
+ * builds Embree's scenes in its robust mode (RTC_SCENE_FLAG_ROBUST): ours
+ * never miss (conservative boxes, exact triangles), Embree's default mode may. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -91,6 +93,7 @@ int main(int argc, char **argv) {
     const char *const *specs = A.specs;
 #ifdef CBVH_HAVE_EMBREE
     RTCDevice dev = embree_device(A.isa);
+    if (A.robust) printf("embree scenes: RTC_SCENE_FLAG_ROBUST\n");
 #else
     printf("(built without Embree: no baseline, absolute rays/s only)\n");
 #endif
@@ -114,7 +117,7 @@ int main(int argc, char **argv) {
         cbvh_scene_bounds(&s, lo, hi);
         make_rays(lo, hi, nrays, rays);
 #ifdef CBVH_HAVE_EMBREE
-        RTCScene sc = embree_scene(dev, &s);
+        RTCScene sc = embree_scene(dev, &s, A.robust);
 #endif
         const char *base = scene_base(specs[si]);
         for (int half = 0; half < 2; half++) {

@@ -17,7 +17,7 @@
  * measurement, not a tracer the kit uses: the sweep, the charts and every
  * counter stay on the binary trees.
  *
- * usage: bench_wide [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [SCENE...]
+ * usage: bench_wide [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]
  *   as bench_traverse; default 20000 rays (half camera, half random), 7 reps. */
 #define _POSIX_C_SOURCE 200809L
 #include "cbvh/qbvh.h"
@@ -246,6 +246,7 @@ int main(int argc, char **argv) {
     const char *const *specs = A.specs;
 #ifdef CBVH_HAVE_EMBREE
     RTCDevice dev = embree_device(A.isa);
+    if (A.robust) printf("embree scenes: RTC_SCENE_FLAG_ROBUST\n");
 #else
     printf("(built without Embree: no baseline, absolute rays/s only)\n");
 #endif
@@ -290,7 +291,7 @@ int main(int argc, char **argv) {
             status = 1;
         }
 #ifdef CBVH_HAVE_EMBREE
-        RTCScene sc = embree_scene(dev, &s);
+        RTCScene sc = embree_scene(dev, &s, A.robust);
 #endif
         for (int half = 0; half < 2; half++) {
             const cbvh_ray *rr = rays + (half ? nrays / 2 : 0);

@@ -20,6 +20,11 @@
 //   ROUND the M-bit truncation plus sticky is rounded once (toward -Inf for
 //         t_near, +Inf for t_far) on the coarser of the M-bit and the binary32
 //         grid (both powers of two, nested), with IEEE directed overflow
+//         (3 cycles: exponent, both candidate results, the choice)
+// A plane's operands and the three FORM terms are latched when the plane
+// starts, and the running t_near/t_far are compared one cycle after they are
+// updated, so that no path crosses two of these steps: the unit closes at
+// about 15 MHz on the iCE40UP5K, above the board's 12 MHz clock.
 // D = 0 axes only need the signs of L - O and H - O (FORM alone).
 //
 // Handshake: start is a one-cycle pulse, inputs stay stable until done; busy is
@@ -103,7 +108,8 @@ module cbvh_ray_box (
     // ------------------------------------------------------------- sequencer
     localparam [3:0] S_IDLE = 4'd0, S_PLANE = 4'd1, S_FORM = 4'd2, S_POST = 4'd3,
                      S_NEG = 4'd4, S_ROT = 4'd5, S_DIV = 4'd6, S_ROUND = 4'd7,
-                     S_UPD = 4'd8, S_NEXT = 4'd9, S_FIN = 4'd10;
+                     S_UPD = 4'd8, S_NEXT = 4'd9, S_FIN = 4'd10,
+                     S_EXP = 4'd11, S_RND = 4'd12;
     reg [3:0]   state;
     reg [1:0]   axis;       // 0 x, 1 y, 2 z
     reg         plane;      // 0: L = u + r 2^e, 1: H = u + s 2^e
@@ -124,55 +130,38 @@ module cbvh_ray_box (
 
     assign busy = (state != S_IDLE);
 
-    // per-axis operands
-    reg [31:0] o_a, d_a, u_a;
-    reg [7:0]  e_a;
-    reg [11:0] r_a, s_a;
+    // per-axis operands, selected by axis/plane and latched in S_PLANE so that
+    // no path runs from the axis counter through the operand muxes (timing)
+    reg [31:0] o_m, d_m, u_m;
+    reg [7:0]  e_m;
+    reg [11:0] r_m, s_m;
     always @* begin
         case (axis)
-            2'd1:    begin o_a = oy; d_a = dy; u_a = y_u; e_a = y_scale; r_a = y_r; s_a = y_s; end
-            2'd2:    begin o_a = oz; d_a = dz; u_a = z_u; e_a = z_scale; r_a = z_r; s_a = z_s; end
-            default: begin o_a = ox; d_a = dx; u_a = x_u; e_a = x_scale; r_a = x_r; s_a = x_s; end
+            2'd1:    begin o_m = oy; d_m = dy; u_m = y_u; e_m = y_scale; r_m = y_r; s_m = y_s; end
+            2'd2:    begin o_m = oz; d_m = dz; u_m = z_u; e_m = z_scale; r_m = z_r; s_m = z_s; end
+            default: begin o_m = ox; d_m = dx; u_m = x_u; e_m = x_scale; r_m = x_r; s_m = x_s; end
         endcase
     end
-    wire [11:0] code = plane ? s_a : r_a;               // <= 1024 once checked
-    wire d_zero = (d_a[30:0] == 31'd0);
-    wire d_neg  = d_a[31];
-    // D = Dsig * 2^eD
-    wire [23:0] d_sig = {|d_a[30:23], d_a[22:0]};
-    wire [11:0] d_exp = (d_a[30:23] == 8'd0) ? -12'sd149 : ({4'd0, d_a[30:23]} - 12'd150);
+    reg        d_zero, d_neg;
+    reg [23:0] d_sig;       // D = d_sig * 2^d_exp
+    reg [11:0] d_exp;
     wire [4:0]  m_bits = mant[4:0];                         // 3..24 once checked
     // plane roles: D > 0: L near, H far; D < 0: H near, L far
     wire near_role = (plane == d_neg);
 
     // ---------------------------------------------- FORM term chunk extractor
     // a binary32 x = sig * 2^(pos - 149) with pos = max(E, 1) - 1; the exponent
-    // field 255 of u = -Inf gives 2^23 * 2^105 = -2^128 (§3)
-    reg [23:0] tsig;
-    reg [8:0]  tpos;
-    reg        tneg;
-    always @* begin
-        case (ti)
-            2'd0: begin
-                tsig = {|u_a[30:23], u_a[22:0]};
-                tpos = (u_a[30:23] == 8'd0) ? 9'd0 : ({1'b0, u_a[30:23]} - 9'd1);
-                tneg = u_a[31];
-            end
-            2'd1: begin
-                tsig = {12'd0, code};
-                tpos = {e_a[7], e_a} + 9'd149;              // e in [-126, 126]
-                tneg = 1'b0;
-            end
-            default: begin
-                tsig = {|o_a[30:23], o_a[22:0]};
-                tpos = (o_a[30:23] == 8'd0) ? 9'd0 : ({1'b0, o_a[30:23]} - 9'd1);
-                tneg = ~o_a[31];                            // the term is -O
-            end
-        endcase
-    end
+    // field 255 of u = -Inf gives 2^23 * 2^105 = -2^128 (§3). The three terms
+    // (u, c 2^e with c = r for L and s for H, -O) are latched in S_PLANE.
+    wire [11:0] code_m = plane ? s_m : r_m;                 // <= 1024 once checked
+    reg  [23:0] tsig_u, tsig_c, tsig_o;
+    reg  [9:0]  tpos24_u, tpos24_c, tpos24_o;                // pos + 24
+    reg         tneg_u, tneg_o;
+    wire [23:0] tsig   = (ti == 2'd0) ? tsig_u : (ti == 2'd1) ? tsig_c : tsig_o;
+    wire [9:0]  tpos24 = (ti == 2'd0) ? tpos24_u : (ti == 2'd1) ? tpos24_c : tpos24_o;
+    wire        tneg   = (ti == 2'd0) ? tneg_u : (ti == 2'd2) & tneg_o;
     // bits [32j, 32j + 32) of tsig << tpos: with tt = tpos + 24 - 32j the chunk
     // is (tsig * 2^32 >> (56 - tt)) mod 2^32 when 0 <= tt <= 55, else zero
-    wire [9:0]  tpos24 = {1'b0, tpos} + 10'd24;
     wire [9:0]  j32    = {1'b0, j, 5'd0};
     wire [9:0]  tt     = tpos24 - j32;
     wire        t_in   = (tpos24 >= j32) && (tt <= 10'd55);
@@ -207,7 +196,10 @@ module cbvh_ray_box (
     // ------------------------------------------------------------- rounding
     // |N / D| = (q + f) * 2^X, f in [0, 1) (f > 0 iff sticky), q in [2^(M-1), 2^M),
     // X = 139 - t - 32 sh - eD (R's top bit weighs 2^137 before the shifts)
-    wire [11:0] x_exp = 12'd139 - {4'd0, t} - {3'd0, sh, 5'd0} - d_exp;
+    // Three cycles (timing): S_EXP latches X, S_RND both candidate results
+    // (normal, and below 2^-126 the kept and lost bits), S_ROUND the choice.
+    wire [11:0] x_exp_n = 12'd139 - {4'd0, t} - {3'd0, sh, 5'd0} - d_exp;
+    reg  [11:0] x_exp;
     wire [11:0] k_exp = x_exp + {7'd0, m_bits} - 12'd1;       // exponent of q's top bit
     wire        q_neg = sgn_n ^ d_neg;
     wire        up    = ~near_role;                            // far: toward +Inf
@@ -230,11 +222,14 @@ module cbvh_ray_box (
     wire [48:0] q_sh   = {q, 25'd0} >> dr;
     wire [23:0] q_kept = q_sh[48:25];
     wire        q_lost = |q_sh[24:0];
-    wire [23:0] s_inc  = {23'd0, away & (sticky | q_lost)};
     wire [30:0] s_up   = {6'd0, m_n} << ss[4:0];               // ss <= 23 - M here
-    wire [30:0] s_dn   = {7'd0, q_kept + s_inc};
-    wire [30:0] s_body = ss_pos ? s_up : s_dn;
-    wire [30:0] body   = r_norm ? n_body : s_body;
+    reg  [30:0] n_body_r, s_up_r;
+    reg  [23:0] q_kept_r;
+    reg         q_lost_r, ss_pos_r, r_norm_r;
+    wire [23:0] s_inc  = {23'd0, away & (sticky | q_lost_r)};
+    wire [30:0] s_dn   = {7'd0, q_kept_r + s_inc};
+    wire [30:0] s_body = ss_pos_r ? s_up_r : s_dn;
+    wire [30:0] body   = r_norm_r ? n_body_r : s_body;
     wire [31:0] rnd    = (body == 31'd0) ? 32'd0 : {q_neg, body};
     // bits computed by the full-width expressions above that are never needed
     wire unused_bits = &{1'b0, t_ext[55:32], m_al[24:23], n_bexp[11:8]};
@@ -271,6 +266,18 @@ module cbvh_ray_box (
                     end
                 end
                 S_PLANE: begin
+                    tsig_u   <= {|u_m[30:23], u_m[22:0]};
+                    tpos24_u <= (u_m[30:23] == 8'd0) ? 10'd24 : ({2'd0, u_m[30:23]} + 10'd23);
+                    tneg_u   <= u_m[31];
+                    tsig_c   <= {12'd0, code_m};
+                    tpos24_c <= {{2{e_m[7]}}, e_m} + 10'd173;    // e in [-126, 126]: 23..299
+                    tsig_o   <= {|o_m[30:23], o_m[22:0]};
+                    tpos24_o <= (o_m[30:23] == 8'd0) ? 10'd24 : ({2'd0, o_m[30:23]} + 10'd23);
+                    tneg_o   <= ~o_m[31];                        // the term is -O
+                    d_zero <= (d_m[30:0] == 31'd0);
+                    d_neg  <= d_m[31];
+                    d_sig  <= {|d_m[30:23], d_m[22:0]};
+                    d_exp  <= (d_m[30:23] == 8'd0) ? -12'sd149 : ({4'd0, d_m[30:23]} - 12'd150);
                     R  <= 288'd0;
                     ti <= 2'd0;
                     j  <= 4'd0;
@@ -326,8 +333,21 @@ module cbvh_ray_box (
                     t   <= t_n;
                     if (q_full) begin
                         sticky <= (|rem_n) | (|R[286:0]);
-                        state  <= S_ROUND;
+                        state  <= S_EXP;
                     end
+                end
+                S_EXP: begin
+                    x_exp <= x_exp_n;
+                    state <= S_RND;
+                end
+                S_RND: begin
+                    n_body_r <= n_body;
+                    s_up_r   <= s_up;
+                    q_kept_r <= q_kept;
+                    q_lost_r <= q_lost;
+                    ss_pos_r <= ss_pos;
+                    r_norm_r <= r_norm;
+                    state    <= S_ROUND;
                 end
                 S_ROUND: begin
                     res   <= rnd;
@@ -336,16 +356,15 @@ module cbvh_ray_box (
                 S_UPD: begin
                     near_r <= near_u;
                     far_r  <= far_u;
-                    // the running max only grows and the min only shrinks
-                    if (fkey(near_u) > fkey(far_u)) begin
-                        miss  <= 1'b1;
-                        state <= S_FIN;
-                    end else begin
-                        state <= S_NEXT;
-                    end
+                    state  <= S_NEXT;
                 end
                 S_NEXT: begin
-                    if (last_plane) begin
+                    // the running max only grows and the min only shrinks
+                    // (compared here, not in S_UPD: one compare per cycle)
+                    if (fkey(near_r) > fkey(far_r)) begin
+                        miss  <= 1'b1;
+                        state <= S_FIN;
+                    end else if (last_plane) begin
                         state <= S_FIN;
                     end else begin
                         if (plane) axis <= axis + 2'd1;
