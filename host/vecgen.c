@@ -1571,6 +1571,28 @@ static void reject_combinations_ray_tri(gen_t *g) {
         if ((k & 8) && !(k & 2)) d[0] = pinf; /* an Inf direction component */
         emit_ray_tri(g, o, d, v);
     }
+    /* Generator 5, after a clean-room RTL (docs/gateware.md): no level-1
+     * vector needed more than 807 bits for an exact sum, so an 832-bit
+     * accumulator passed them all.  Vertices +-a along the rows of
+     * [[1, 1, -1], [-1, 1, 1], [1, -1, 1]] (determinant 4) with a near 2^127:
+     * the triple product [v0, v2, v1] is 4 a^3 (about 2^386, 834 bits in the
+     * units' 2^-447 grid); rays from o = 0 along +-(1, 1, 1) s through the
+     * centroid (hit, or t < 0) with s = 1 and s = a (det ~ a^3 too), with the
+     * vertices negated, and with v1, v2 swapped (the other winding). */
+    const cbvh_f32 big[] = {0x7F7FFFFFu /* FLT_MAX */, 0x7F000000u /* 2^127 */, 0x7EC00000u /* 1.5 2^126 */};
+    static const int rows[3][3] = {{1, 1, -1}, {-1, 1, 1}, {1, -1, 1}};
+    for (size_t bi = 0; bi < sizeof big / sizeof big[0]; bi++)
+        for (int var = 0; var < 8; var++) {
+            int neg = var & 1, swap = (var >> 1) & 1, dneg = (var >> 2) & 1;
+            cbvh_f32 v[9], o[3] = {0, 0, 0}, d[3];
+            for (int i = 0; i < 3; i++) {
+                int src = swap && i ? 3 - i : i;
+                for (int a = 0; a < 3; a++)
+                    v[3 * i + a] = big[bi] | ((rows[src][a] < 0) != neg ? CBVH_F32_SIGN : 0);
+            }
+            for (int a = 0; a < 3; a++) d[a] = (bi == 0 ? F_ONE : big[bi]) | (dneg ? CBVH_F32_SIGN : 0);
+            emit_ray_tri(g, o, d, v);
+        }
 }
 
 static void reject_combinations_ray_sphere(gen_t *g) {

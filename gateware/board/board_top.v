@@ -20,6 +20,7 @@ module cbvh_board_top #(
     parameter integer HAS_NP_ENCODER = 1,
     parameter integer HAS_NP_DECODER = 1,
     parameter integer HAS_RAY_BOX    = 1,
+    parameter integer HAS_RAY_TRI    = 1,   // unit 7 (sequential, as the ray box)
     parameter integer HAS_QBVH_STACK = 1,
     parameter integer HAS_RAY_SPHERE = 1   // unit 9 (sequential, as the ray box)
 ) (
@@ -49,7 +50,7 @@ module cbvh_board_top #(
         .N(N), .E_MIN(E_MIN), .ENCODINGS(ENCODINGS),
         .HAS_ESTIMATOR(HAS_ESTIMATOR), .HAS_COMPRESSOR(HAS_COMPRESSOR),
         .HAS_DECODER(HAS_DECODER), .HAS_NP_ENCODER(HAS_NP_ENCODER),
-        .HAS_NP_DECODER(HAS_NP_DECODER), .HAS_RAY_BOX(HAS_RAY_BOX),
+        .HAS_NP_DECODER(HAS_NP_DECODER), .HAS_RAY_BOX(HAS_RAY_BOX), .HAS_RAY_TRI(HAS_RAY_TRI),
         .HAS_QBVH_STACK(HAS_QBVH_STACK), .HAS_RAY_SPHERE(HAS_RAY_SPHERE)
     ) u_regs (
         .clk(clk), .rst(rst),

@@ -16,7 +16,8 @@
 // A unit accepts CONFIG when it is built and, for units 1-5, CONFIG's N and
 // min_scale equal the parameters N and E_MIN; for units 3-5 the encoding of
 // CONFIG[24] must also be built (ENCODINGS bit 0 modulo, bit 1 relative).
-// Units 6 (ray box), 8 (QBVH stack) and 9 (ray sphere) accept any CONFIG.
+// Units 6 (ray box), 7 (ray triangle), 8 (QBVH stack) and 9 (ray sphere)
+// accept any CONFIG.
 //
 // Start of a combinational unit: STATUS = done and OUT latches the unit's
 // outputs one clock after the CTRL write, then keeps re-latching them for
@@ -28,7 +29,8 @@
 // at least 56 SCK periods (>= 448 clk) later. So the paths IN -> unit -> OUT
 // are multicycle paths, and the design's nextpnr fmax (which counts them as
 // single-cycle) understates what it runs at.
-// Start of a sequential unit (6 ray box, 9 ray sphere): its start is pulsed
+// Start of a sequential unit (6 ray box, 7 ray triangle, 9 ray sphere): its
+// start is pulsed
 // and which unit runs is latched, STATUS = busy until that unit's done, then
 // OUT latches its (registered) outputs and STATUS = done. A UNIT_SEL write
 // during the run does not change what OUT captures; CTRL reset aborts the run.
@@ -45,6 +47,7 @@ module cbvh_datapath_regs #(
     parameter integer HAS_NP_ENCODER = 1,    // unit 4 nodepair_encode
     parameter integer HAS_NP_DECODER = 1,    // unit 5 nodepair_decode
     parameter integer HAS_RAY_BOX    = 1,    // unit 6 ray_box
+    parameter integer HAS_RAY_TRI    = 1,    // unit 7 ray_triangle
     parameter integer HAS_QBVH_STACK = 1,    // unit 8 qbvh_stack
     parameter integer HAS_RAY_SPHERE = 1     // unit 9 ray_sphere
 ) (
@@ -69,10 +72,11 @@ module cbvh_datapath_regs #(
     localparam integer B4 = (HAS_NP_ENCODER != 0 && (ENC_MOD + ENC_REL) != 0) ? 1 : 0;
     localparam integer B5 = (HAS_NP_DECODER != 0 && (ENC_MOD + ENC_REL) != 0) ? 1 : 0;
     localparam integer B6 = (HAS_RAY_BOX != 0) ? 1 : 0;
+    localparam integer B7 = (HAS_RAY_TRI != 0) ? 1 : 0;
     localparam integer B8 = (HAS_QBVH_STACK != 0) ? 1 : 0;
     localparam integer B9 = (HAS_RAY_SPHERE != 0) ? 1 : 0;
     localparam [31:0] UNITS_MASK = (B1 << 1) | (B2 << 2) | (B3 << 3) | (B4 << 4) |
-                                   (B5 << 5) | (B6 << 6) | (B8 << 8) | (B9 << 9);
+                                   (B5 << 5) | (B6 << 6) | (B7 << 7) | (B8 << 8) | (B9 << 9);
 
     // shapes (rtl-model/src/unit_table.c): input and output words per unit
     localparam integer NIN1 = 2,  NOUT1 = 2;
@@ -81,6 +85,7 @@ module cbvh_datapath_regs #(
     localparam integer NIN4 = 28, NOUT4 = (N <= 6) ? 5 : 7;
     localparam integer NIN5 = (N <= 6) ? 16 : 18, NOUT5 = 35;
     localparam integer NIN6 = 21, NOUT6 = 4;
+    localparam integer NIN7 = 15, NOUT7 = 5;
     localparam integer NIN8 = 8,  NOUT8 = 6;
     localparam integer NIN9 = 12, NOUT9 = 2;
 
@@ -92,10 +97,10 @@ module cbvh_datapath_regs #(
     // (at least one, so that no vector has width zero)
     localparam integer IN_WORDS =
         max2(1, max2(max2(max2(B1 * NIN1, B2 * NIN2), max2(B3 * NIN3, B4 * NIN4)),
-                     max2(max2(B5 * NIN5, B6 * NIN6), max2(B8 * NIN8, B9 * NIN9))));
+                     max2(max2(B5 * NIN5, B6 * NIN6), max2(B7 * NIN7, max2(B8 * NIN8, B9 * NIN9)))));
     localparam integer OUT_WORDS =
         max2(1, max2(max2(max2(B1 * NOUT1, B2 * NOUT2), max2(B3 * NOUT3, B4 * NOUT4)),
-                     max2(max2(B5 * NOUT5, B6 * NOUT6), max2(B8 * NOUT8, B9 * NOUT9))));
+                     max2(max2(B5 * NOUT5, B6 * NOUT6), max2(B7 * NOUT7, max2(B8 * NOUT8, B9 * NOUT9)))));
 
     localparam [31:0] N_W = N;          // 32-bit copies to take the field bits from
     localparam [31:0] E_MIN_W = E_MIN;
@@ -123,7 +128,7 @@ module cbvh_datapath_regs #(
     reg  [3:0]              recap;      // re-captures of a combinational unit still to do
     // the sequential unit that runs (one-hot), latched at its start so that a
     // UNIT_SEL write during the run cannot redirect the capture
-    reg                     run6, run9;
+    reg                     run6, run7, run9;
 
     wire ctrl_wr    = wr_en && (wr_addr == A_CTRL);
     wire ctrl_reset = ctrl_wr && wr_data[1];
@@ -133,34 +138,37 @@ module cbvh_datapath_regs #(
     wire rel    = config_r[24];
     wire enc_ok = rel ? (ENC_REL != 0) : (ENC_MOD != 0);
     // UNIT_SEL decoded when written (one id at a time; 0 for any other value)
-    reg  sel1, sel2, sel3, sel4, sel5, sel6, sel8, sel9;
+    reg  sel1, sel2, sel3, sel4, sel5, sel6, sel7, sel8, sel9;
     wire acc1 = (B1 != 0) && cfg_ok;
     wire acc2 = (B2 != 0) && cfg_ok;
     wire acc3 = (B3 != 0) && cfg_ok && enc_ok;
     wire acc4 = (B4 != 0) && cfg_ok && enc_ok;
     wire acc5 = (B5 != 0) && cfg_ok && enc_ok;
     wire acc6 = (B6 != 0);
+    wire acc7 = (B7 != 0);
     wire acc8 = (B8 != 0);
     wire acc9 = (B9 != 0);
     wire sel_acc = (sel1 && acc1) || (sel2 && acc2) || (sel3 && acc3) || (sel4 && acc4) ||
-                   (sel5 && acc5) || (sel6 && acc6) || (sel8 && acc8) || (sel9 && acc9);
-    wire sel_seq = (sel6 && acc6) || (sel9 && acc9);   // a built sequential unit is selected
+                   (sel5 && acc5) || (sel6 && acc6) || (sel7 && acc7) || (sel8 && acc8) || (sel9 && acc9);
+    // a built sequential unit is selected
+    wire sel_seq = (sel6 && acc6) || (sel7 && acc7) || (sel9 && acc9);
 
     // {n_out, n_in} of each unit, as 32-bit constants
     localparam [31:0] SH1 = NOUT1 * 256 + NIN1, SH2 = NOUT2 * 256 + NIN2,
                       SH3 = NOUT3 * 256 + NIN3, SH4 = NOUT4 * 256 + NIN4,
                       SH5 = NOUT5 * 256 + NIN5, SH6 = NOUT6 * 256 + NIN6,
-                      SH8 = NOUT8 * 256 + NIN8, SH9 = NOUT9 * 256 + NIN9;
+                      SH7 = NOUT7 * 256 + NIN7, SH8 = NOUT8 * 256 + NIN8,
+                      SH9 = NOUT9 * 256 + NIN9;
     wire [31:0] shape_u = ({32{sel1}} & SH1) | ({32{sel2}} & SH2) | ({32{sel3}} & SH3) |
                           ({32{sel4}} & SH4) | ({32{sel5}} & SH5) | ({32{sel6}} & SH6) |
-                          ({32{sel8}} & SH8) | ({32{sel9}} & SH9);
+                          ({32{sel7}} & SH7) | ({32{sel8}} & SH8) | ({32{sel9}} & SH9);
     wire [31:0] shape = sel_acc ? shape_u : 32'd0;
 
     // ------------------------------------------------------------------- units
     // Each built unit's outputs as OUT_WORDS zero-extended words; unbuilt: zero.
     wire [OUT_WORDS*32-1:0] u1_bus, u2_bus, u3_bus, u4_bus, u5_bus, u8_bus;
-    wire [OUT_WORDS*32-1:0] rb_bus, rs_bus;
-    wire                    rb_done, rs_done;
+    wire [OUT_WORDS*32-1:0] rb_bus, rt_bus, rs_bus;
+    wire                    rb_done, rt_done, rs_done;
 
     // a start is handled the clock after its CTRL write, after the reset of
     // the same write has zeroed IN (as the C model: reset, then start); a
@@ -249,6 +257,28 @@ module cbvh_datapath_regs #(
             assign rb_done = 1'b0;
         end
 
+        if (B7 != 0) begin : g_rt
+            wire        busy_unused;  // STATUS.busy is kept here, from start to done
+            wire        rt_start = start_go && sel7 && acc7;
+            wire        rt_rst   = rst || ctrl_reset;   // CTRL reset aborts a run
+            wire        hit;
+            wire [31:0] t, b1, b2;
+            wire [7:0]  st;
+            cbvh_ray_triangle u_rt (
+                .clk(clk), .rst(rt_rst), .start(rt_start), .busy(busy_unused), .done(rt_done),
+                .ox(in_w[0*32 +: 32]), .oy(in_w[1*32 +: 32]), .oz(in_w[2*32 +: 32]),
+                .dx(in_w[3*32 +: 32]), .dy(in_w[4*32 +: 32]), .dz(in_w[5*32 +: 32]),
+                .v0x(in_w[6*32 +: 32]), .v0y(in_w[7*32 +: 32]), .v0z(in_w[8*32 +: 32]),
+                .v1x(in_w[9*32 +: 32]), .v1y(in_w[10*32 +: 32]), .v1z(in_w[11*32 +: 32]),
+                .v2x(in_w[12*32 +: 32]), .v2y(in_w[13*32 +: 32]), .v2z(in_w[14*32 +: 32]),
+                .hit(hit), .t(t), .b1(b1), .b2(b2), .status(st));
+            wire [NOUT7*32-1:0] o = {{24'd0, st}, b2, b1, t, {31'd0, hit}};
+            cbvh_board_pad #(.NW(NOUT7), .OW(OUT_WORDS)) u_pad (.o(o), .bus(rt_bus));
+        end else begin : g_no_rt
+            assign rt_bus  = {OUT_WORDS*32{1'b0}};
+            assign rt_done = 1'b0;
+        end
+
         if (B8 != 0) begin : g_qbvh
             wire [31:0] node, next_entry;
             wire        write;
@@ -312,7 +342,7 @@ module cbvh_datapath_regs #(
         if (rst) begin
             config_r <= 32'd0;
             unit_sel <= 32'd0;
-            {sel1, sel2, sel3, sel4, sel5, sel6, sel8, sel9} <= 8'd0;
+            {sel1, sel2, sel3, sel4, sel5, sel6, sel7, sel8, sel9} <= 9'd0;
         end else if (wr_en) begin
             if (wr_addr == A_CONFIG) config_r <= wr_data;
             if (wr_addr == A_UNIT_SEL) begin
@@ -323,6 +353,7 @@ module cbvh_datapath_regs #(
                 sel4 <= (wr_data == 32'd4);
                 sel5 <= (wr_data == 32'd5);
                 sel6 <= (wr_data == 32'd6);
+                sel7 <= (wr_data == 32'd7);
                 sel8 <= (wr_data == 32'd8);
                 sel9 <= (wr_data == 32'd9);
             end
@@ -331,9 +362,9 @@ module cbvh_datapath_regs #(
 
     // OUT latches a combinational unit's outputs (start, then re-captures)
     // or, when its done pulses, those of the sequential unit that was started
-    wire cap_seq  = (run6 && rb_done) || (run9 && rs_done);
+    wire cap_seq  = (run6 && rb_done) || (run7 && rt_done) || (run9 && rs_done);
     wire cap_comb = (start_go && sel_acc && !sel_seq) || (recap != 4'd0);
-    wire [OB-1:0] seq_bus = ({OB{run6}} & rb_bus) | ({OB{run9}} & rs_bus);
+    wire [OB-1:0] seq_bus = ({OB{run6}} & rb_bus) | ({OB{run7}} & rt_bus) | ({OB{run9}} & rs_bus);
 
     always @(posedge clk) begin
         start_req <= !rst && ctrl_wr && wr_data[0];
@@ -341,6 +372,7 @@ module cbvh_datapath_regs #(
             status <= 3'd0;
             recap  <= 4'd0;
             run6   <= 1'b0;
+            run7   <= 1'b0;
             run9   <= 1'b0;
         end else begin
             if (recap != 4'd0)
@@ -348,6 +380,7 @@ module cbvh_datapath_regs #(
             if (cap_seq) begin
                 status <= ST_DONE;
                 run6   <= 1'b0;
+                run7   <= 1'b0;
                 run9   <= 1'b0;
             end
             if (start_go) begin
@@ -356,6 +389,7 @@ module cbvh_datapath_regs #(
                 end else if (sel_seq) begin
                     status <= ST_BUSY;             // the unit's start pulses now
                     run6   <= sel6;
+                    run7   <= sel7;
                     run9   <= sel9;
                 end else begin
                     status <= ST_DONE;

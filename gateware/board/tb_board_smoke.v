@@ -4,7 +4,7 @@
 // the fastest SCK the slave supports (high and low phases of 4 clk), with its
 // edges offset from clk's. It checks ID, VERSION, UNITS, CONFIG and UNIT_SEL
 // readback, SHAPE of every unit id, the first vector lines of
-// axis_compress / ray_box / qbvh_stack / ray_sphere -N6-ms-30.vec (plus their
+// axis_compress / ray_box / qbvh_stack / ray_sphere / ray_triangle -N6-ms-30.vec (plus their
 // second lines) through IN, CTRL, STATUS and OUT, that OUT is latched, CTRL
 // reset (also aborting a sequential unit), that a UNIT_SEL write while the
 // ray sphere runs does not change what OUT captures, start on an unbuilt or
@@ -23,6 +23,7 @@ module tb_board_smoke;
     parameter integer HAS_NP_ENCODER = 1;
     parameter integer HAS_NP_DECODER = 1;
     parameter integer HAS_RAY_BOX    = 1;
+    parameter integer HAS_RAY_TRI    = 1;
     parameter integer HAS_QBVH_STACK = 1;
     parameter integer HAS_RAY_SPHERE = 1;
     parameter integer HALF           = 40;   // SCK half period; clk period 10
@@ -41,10 +42,10 @@ module tb_board_smoke;
                        B3 = HAS_DECODER != 0 && ENCODINGS % 4 != 0,
                        B4 = HAS_NP_ENCODER != 0 && ENCODINGS % 4 != 0,
                        B5 = HAS_NP_DECODER != 0 && ENCODINGS % 4 != 0,
-                       B6 = HAS_RAY_BOX != 0, B8 = HAS_QBVH_STACK != 0,
+                       B6 = HAS_RAY_BOX != 0, B7 = HAS_RAY_TRI != 0, B8 = HAS_QBVH_STACK != 0,
                        B9 = HAS_RAY_SPHERE != 0;
     localparam [31:0] UNITS_EXP = (B1 << 1) | (B2 << 2) | (B3 << 3) | (B4 << 4) | (B5 << 5) |
-                                  (B6 << 6) | (B8 << 8) | (B9 << 9);
+                                  (B6 << 6) | (B7 << 7) | (B8 << 8) | (B9 << 9);
 
     reg  clk = 1'b0;
     always #5 clk = ~clk;
@@ -55,7 +56,7 @@ module tb_board_smoke;
         .N(6), .E_MIN(-30), .ENCODINGS(ENCODINGS),
         .HAS_ESTIMATOR(HAS_ESTIMATOR), .HAS_COMPRESSOR(HAS_COMPRESSOR), .HAS_DECODER(HAS_DECODER),
         .HAS_NP_ENCODER(HAS_NP_ENCODER), .HAS_NP_DECODER(HAS_NP_DECODER),
-        .HAS_RAY_BOX(HAS_RAY_BOX), .HAS_QBVH_STACK(HAS_QBVH_STACK),
+        .HAS_RAY_BOX(HAS_RAY_BOX), .HAS_RAY_TRI(HAS_RAY_TRI), .HAS_QBVH_STACK(HAS_QBVH_STACK),
         .HAS_RAY_SPHERE(HAS_RAY_SPHERE)
     ) dut (.clk(clk), .spi_sck(sck), .spi_cs_n(cs_n), .spi_mosi(mosi), .spi_miso(miso));
 
@@ -221,6 +222,7 @@ module tb_board_smoke;
                 4: shape_exp = (B4 && ok && enc) ? 32'h051C : 0;
                 5: shape_exp = (B5 && ok && enc) ? 32'h2310 : 0;
                 6: shape_exp = B6 ? 32'h0415 : 0;
+                7: shape_exp = B7 ? 32'h050F : 0;
                 8: shape_exp = B8 ? 32'h0608 : 0;
                 9: shape_exp = B9 ? 32'h020C : 0;
                 default: shape_exp = 0;
@@ -247,8 +249,8 @@ module tb_board_smoke;
         expect_reg("VERSION", R_VERSION, 32'd1);
         expect_reg("UNITS", R_UNITS, UNITS_EXP);
         if (ENCODINGS == 1 && HAS_ESTIMATOR && HAS_COMPRESSOR && HAS_DECODER && HAS_NP_ENCODER &&
-            HAS_NP_DECODER && HAS_RAY_BOX && HAS_QBVH_STACK && HAS_RAY_SPHERE)
-            check("UNITS, all built", UNITS_EXP, 32'h37E);
+            HAS_NP_DECODER && HAS_RAY_BOX && HAS_RAY_TRI && HAS_QBVH_STACK && HAS_RAY_SPHERE)
+            check("UNITS, all built", UNITS_EXP, 32'h3FE);
         expect_reg("STATUS after power-on", R_STATUS, 32'd0);
 
         // rw registers keep all 32 bits; read-only and unknown addresses
@@ -278,7 +280,7 @@ module tb_board_smoke;
         reg_write(R_UNIT_SEL, 32'd2);
         run(32'd6);
         reg_write(R_CONFIG, CFG_GOOD);
-        reg_write(R_UNIT_SEL, 32'd7);
+        reg_write(R_UNIT_SEL, 32'd10);
         run(32'd6);
         reg_write(R_UNIT_SEL, 32'h102);
         run(32'd6);
@@ -418,6 +420,25 @@ module tb_board_smoke;
             expect_reg("STATUS after sphere abort", R_STATUS, 32'd0);
             expect_reg("OUT0 after sphere abort", 32'h200, 32'd0);
             vout[0] = 32'd1; vout[1] = 32'h00;
+            run_vector;
+        end else begin
+            run(32'd6);
+        end
+
+        // ray_triangle-N6-ms-30.vec, lines 1 (a hit) and 2 (a miss); any CONFIG
+        reg_write(R_CONFIG, CFG_N7);
+        reg_write(R_UNIT_SEL, 32'd7);
+        if (B7) begin
+            nin = 15; nout = 5;
+            vin[0] = 32'h00000000; vin[1] = 32'h00000000; vin[2] = 32'h40000000;
+            vin[3] = 32'h00000000; vin[4] = 32'h80000000; vin[5] = 32'hBF800000;
+            vin[6] = 32'h00000000; vin[7] = 32'h00000000; vin[8] = 32'h00000000;
+            vin[9] = 32'h3F800000; vin[10] = 32'h00000000; vin[11] = 32'h00000000;
+            vin[12] = 32'h00000000; vin[13] = 32'h3F800000; vin[14] = 32'h00000000;
+            vout[0] = 32'd1; vout[1] = 32'h40000000; vout[2] = 32'h0; vout[3] = 32'h0; vout[4] = 32'h00;
+            run_vector;
+            vin[3] = 32'h3EAAAAAB; vin[4] = 32'hBE800000;
+            vout[0] = 32'd0; vout[1] = 32'h0;
             run_vector;
         end else begin
             run(32'd6);

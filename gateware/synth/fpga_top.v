@@ -121,4 +121,23 @@ module fpga_top_ray_sphere (input wire clk, input wire din, input wire load, inp
         .out_bits({hit, status}), .in_bits(in_sr), .dout(dout));
 endmodule
 
+module fpga_top_ray_triangle (input wire clk, input wire din, input wire load, input wire start,
+                              input wire rst, output wire dout, output wire busy, output wire done);
+    localparam integer IN_W = 15 * 32, OUT_W = 1 + 3 * 32 + 8;
+    wire [IN_W-1:0] in_sr;
+    wire hit;
+    wire [31:0] t, b1, b2;
+    wire [7:0] status;
+    cbvh_ray_triangle unit (
+        .clk(clk), .rst(rst), .start(start), .busy(busy), .done(done),
+        .ox(in_sr[31:0]), .oy(in_sr[63:32]), .oz(in_sr[95:64]), .dx(in_sr[127:96]),
+        .dy(in_sr[159:128]), .dz(in_sr[191:160]),
+        .v0x(in_sr[223:192]), .v0y(in_sr[255:224]), .v0z(in_sr[287:256]),
+        .v1x(in_sr[319:288]), .v1y(in_sr[351:320]), .v1z(in_sr[383:352]),
+        .v2x(in_sr[415:384]), .v2y(in_sr[447:416]), .v2z(in_sr[479:448]),
+        .hit(hit), .t(t), .b1(b1), .b2(b2), .status(status));
+    fpga_shift_io #(.IN_W(IN_W), .OUT_W(OUT_W)) io (.clk(clk), .din(din), .load(load),
+        .out_bits({hit, t, b1, b2, status}), .in_bits(in_sr), .dout(dout));
+endmodule
+
 `default_nettype wire

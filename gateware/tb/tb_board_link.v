@@ -11,11 +11,13 @@
 //   iverilog -g2005 -P tb_board_link.N=6 -P tb_board_link.E_MIN=-30 \
 //       -P tb_board_link.ENCODINGS=3 -o board.vvp gateware/tb/tb_board_link.v \
 //       gateware/board/*.v gateware/rtl/*.v       (gateware/scripts/build-board-sim)
+// UNITS: bit i set = unit i built (cbvh_board_top's HAS_* flags); default all.
 `timescale 1ns / 1ps
 module tb_board_link;
     parameter integer N         = 6;
     parameter integer E_MIN     = -30;
     parameter integer ENCODINGS = 3;
+    parameter integer UNITS     = 32'h3FE;
 
     localparam integer CLK_HALF = 5;            // 100 MHz simulated clock; only ratios matter
     localparam integer SCK_HALF = 4 * 2 * CLK_HALF;
@@ -28,7 +30,10 @@ module tb_board_link;
     reg  sck = 1'b0, cs_n = 1'b1, mosi = 1'b0;
     wire miso;
 
-    cbvh_board_top #(.N(N), .E_MIN(E_MIN), .ENCODINGS(ENCODINGS)) dut (
+    cbvh_board_top #(.N(N), .E_MIN(E_MIN), .ENCODINGS(ENCODINGS),
+        .HAS_ESTIMATOR(UNITS >> 1 & 1), .HAS_COMPRESSOR(UNITS >> 2 & 1), .HAS_DECODER(UNITS >> 3 & 1),
+        .HAS_NP_ENCODER(UNITS >> 4 & 1), .HAS_NP_DECODER(UNITS >> 5 & 1), .HAS_RAY_BOX(UNITS >> 6 & 1),
+        .HAS_RAY_TRI(UNITS >> 7 & 1), .HAS_QBVH_STACK(UNITS >> 8 & 1), .HAS_RAY_SPHERE(UNITS >> 9 & 1)) dut (
         .clk(clk), .spi_sck(sck), .spi_cs_n(cs_n), .spi_mosi(mosi), .spi_miso(miso));
 
     integer fd, rc, n, i, k, b;

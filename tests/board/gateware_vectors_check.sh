@@ -3,8 +3,9 @@
 # --backend sim:ADDR` -> frames -> firmware core -> register-map driver -> SPI
 # bytes -> the board top's RTL (SPI slave, register map, units) simulated by
 # Icarus or Verilator.  It must give exactly the model's results on the
-# default design point's files of every unit with RTL; other design points and
-# units without RTL must be refused with one line naming the problem; a
+# default design point's files of every unit; another design point, and a
+# unit left out of the board's build, must be refused with one line naming the
+# problem; a
 # one-bit fault on the SPI bus must fail exactly that unit's files.
 # A simulated FPGA runs a few hundred vectors per second, so each file is
 # checked on an evenly spread sample (--sample; 0 = every vector).
@@ -46,7 +47,8 @@ board() { # board [extra board-sim options]
 
 # Every unit with RTL at the built design point (N = 6, min scale -30, both encodings).
 files=""
-for u in scale_estimate axis_compress axis_decode nodepair_encode nodepair_decode ray_box ray_sphere qbvh_stack; do
+for u in scale_estimate axis_compress axis_decode nodepair_encode nodepair_decode ray_box ray_triangle ray_sphere \
+         qbvh_stack; do
     for f in "$vec"/$u-N6-ms-30.vec "$vec"/$u-N6-ms-30-*.vec; do
         case $f in *-L2.vec) continue ;; esac
         [ -f "$f" ] && files="$files $f"
@@ -72,17 +74,23 @@ n=$(grep -c -E '\.vec: [1-9][0-9]* passed, 0 failed' "$tmp/gw.out")
 [ "$n" = "$(echo $files | wc -w)" ] || { echo "FAIL: $n files passed, expected $(echo $files | wc -w)"; exit 1; }
 echo "PASS: $n files through firmware, SPI and RTL agree with the model"
 
-# Not built: another design point (config error) and a unit without RTL
-# (unit error), each refused with one line naming why, exit 2.
-for case in "axis_compress-N7-ms-30.vec|config error (the board's unit is not built for this N" \
-            "ray_triangle-N6-ms-30.vec|unit error (the board's datapath has no such unit)"; do
-    f=$vec/${case%%|*} why=${case#*|}
-    "$cbvh" vectors check --backend "sim:unix:$sock" --sample 3 "$f" >"$tmp/refused.out" 2>&1
+# Not built: another design point (config error), and a unit left out of the
+# build (unit error), each refused with one line naming why, exit 2.
+refused() { # refused FILE WHY
+    "$cbvh" vectors check --backend "sim:unix:$sock" --sample 3 "$vec/$1" >"$tmp/refused.out" 2>&1
     rc=$?
-    [ "$rc" = 2 ] || { echo "FAIL: $(basename "$f") on the N6 board gave exit $rc, want 2"; cat "$tmp/refused.out"; exit 1; }
-    grep -q -F "$why" "$tmp/refused.out" || { echo "FAIL: $(basename "$f"): not '$why':"; cat "$tmp/refused.out"; exit 1; }
-    echo "PASS: $(basename "$f") refused: $why"
-done
+    [ "$rc" = 2 ] || { echo "FAIL: $1 gave exit $rc, want 2"; cat "$tmp/refused.out"; exit 1; }
+    grep -q -F "$2" "$tmp/refused.out" || { echo "FAIL: $1: not '$2':"; cat "$tmp/refused.out"; exit 1; }
+    echo "PASS: $1 refused: $2"
+}
+refused axis_compress-N7-ms-30.vec "config error (the board's unit is not built for this N"
+bash "$gw/scripts/build-board-sim" --sim "$sim" -o "$prog-nosphere" -n 6 -e -30 --encodings both \
+    --units 1,2,3,4,5,6,7,8 || { echo "FAIL: build-board-sim --units"; exit 1; }
+prog_all=$prog
+prog=$prog-nosphere
+board
+refused ray_sphere-N6-ms-30.vec "unit error (the board's datapath has no such unit)"
+prog=$prog_all
 
 # A one-bit fault on the bus (OUT[0] of axis_compress) fails exactly those files.
 board --break-unit axis_compress
