@@ -60,16 +60,6 @@ module cbvh_ray_box (
 /* verilator lint_on DECLFILENAME */
 
     // --------------------------------------------------------------- helpers
-    // order key of a binary32 (no NaN here); -0 and +0 get the same key
-    function [31:0] fkey;
-        input [31:0] f;
-        begin
-            if (f[30:0] == 31'd0)   fkey = 32'h80000000;
-            else if (f[31])         fkey = ~f;
-            else                    fkey = {1'b1, f[30:0]};
-        end
-    endfunction
-
     function is_nan;
         input [30:0] f;
         begin
@@ -235,8 +225,12 @@ module cbvh_ray_box (
     wire unused_bits = &{1'b0, t_ext[55:32], m_al[24:23], n_bexp[11:8]};
 
     // ---------------------------------------------------------- accumulators
-    wire [31:0] near_u = (near_role && (fkey(res) > fkey(near_r))) ? res : near_r;
-    wire [31:0] far_u  = (!near_role && (fkey(res) < fkey(far_r))) ? res : far_r;
+    wire res_gt_near, far_gt_res, near_gt_far;
+    cbvh_f32_gt u_gt_near (.a(res), .b(near_r), .gt(res_gt_near));
+    cbvh_f32_gt u_gt_far  (.a(far_r), .b(res), .gt(far_gt_res));
+    cbvh_f32_gt u_gt_nf   (.a(near_r), .b(far_r), .gt(near_gt_far));
+    wire [31:0] near_u = (near_role && res_gt_near) ? res : near_r;
+    wire [31:0] far_u  = (!near_role && far_gt_res) ? res : far_r;
     wire        last_plane = (axis == 2'd2) && plane;
 
     always @(posedge clk) begin
@@ -361,7 +355,7 @@ module cbvh_ray_box (
                 S_NEXT: begin
                     // the running max only grows and the min only shrinks
                     // (compared here, not in S_UPD: one compare per cycle)
-                    if (fkey(near_r) > fkey(far_r)) begin
+                    if (near_gt_far) begin
                         miss  <= 1'b1;
                         state <= S_FIN;
                     end else if (last_plane) begin
@@ -373,7 +367,7 @@ module cbvh_ray_box (
                     end
                 end
                 S_FIN: begin
-                    if (!miss && (fkey(near_r) <= fkey(far_r))) begin
+                    if (!miss && !near_gt_far) begin
                         hit    <= 1'b1;
                         // a zero distance leaves as +0 (tmin/tmax may be -0; §3)
                         t_near <= (near_r[30:0] == 31'd0) ? 32'd0 : near_r;
@@ -408,4 +402,24 @@ module cbvh_ray_check (
                      (&dx[30:23]) | (&dy[30:23]) | (&dz[30:23]) | (&tmin[30:23]) |
                      ((&tmax[30:23]) & (|tmax[22:0])) | (tmax == 32'hFF800000);
     assign zero_dir = ~nan_inf & (dx[30:0] == 31'd0) & (dy[30:0] == 31'd0) & (dz[30:0] == 31'd0);
+endmodule
+
+// a > b in value order for binary32 without NaN (-0 = +0, -Inf and +Inf
+// allowed), by order keys; shared by the ray units (kept with the first).
+/* verilator lint_off DECLFILENAME */
+module cbvh_f32_gt (
+    input  wire [31:0] a,
+    input  wire [31:0] b,
+    output wire        gt
+);
+/* verilator lint_on DECLFILENAME */
+    function [31:0] fkey;   // -0 and +0 get the same key
+        input [31:0] f;
+        begin
+            if (f[30:0] == 31'd0)   fkey = 32'h80000000;
+            else if (f[31])         fkey = ~f;
+            else                    fkey = {1'b1, f[30:0]};
+        end
+    endfunction
+    assign gt = fkey(a) > fkey(b);
 endmodule

@@ -70,16 +70,6 @@ module cbvh_ray_sphere (
 /* verilator lint_on DECLFILENAME */
 
     // --------------------------------------------------------------- helpers
-    // order key of a binary32 (no NaN here); -0 and +0 get the same key
-    function [31:0] fkey;
-        input [31:0] f;
-        begin
-            if (f[30:0] == 31'd0)   fkey = 32'h80000000;
-            else if (f[31])         fkey = ~f;
-            else                    fkey = {1'b1, f[30:0]};
-        end
-    endfunction
-
     function is_naninf;     // exponent field all ones
         input [7:0] ef;
         begin
@@ -97,7 +87,8 @@ module cbvh_ray_sphere (
                         is_naninf(r[30:23]) |
                         (r[31] & (r[30:0] != 31'd0));
     wire [7:0] st_all = {st_zero_dir, 3'b000, st_bad_param, 2'b00, ray_bad};
-    wire empty_seg = fkey(tmin) > fkey(tmax);
+    wire empty_seg;
+    cbvh_f32_gt u_empty (.a(tmin), .b(tmax), .gt(empty_seg));
     wire tmax_inf  = (tmax == 32'h7F800000);
 
     // --------------------------------------------------------------- factors

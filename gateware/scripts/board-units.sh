@@ -3,7 +3,7 @@
 #   board_flags  cbvh_board_top's HAS_* parameters, in unit id order
 #   board_names  the units' names (as in vector files), board_ids their ids
 #   board_units LIST ME   sets board_on[i] = 1 for each unit of LIST (names or
-#                ids, comma-separated; "none" = no unit); a bad entry exits 2
+#                ids, comma-separated; "none" = no unit, "all" = every unit); a bad entry exits 2
 #                with one line naming it, prefixed by ME
 board_flags=(HAS_ESTIMATOR HAS_COMPRESSOR HAS_DECODER HAS_NP_ENCODER HAS_NP_DECODER HAS_RAY_BOX HAS_RAY_TRI
              HAS_QBVH_STACK HAS_RAY_SPHERE)
@@ -16,6 +16,10 @@ board_units() {
     board_on=()
     for i in "${!board_names[@]}"; do board_on[$i]=0; done
     [ "$list" = none ] && return 0
+    if [ "$list" = all ]; then
+        for i in "${!board_names[@]}"; do board_on[$i]=1; done
+        return 0
+    fi
     [ -n "$list" ] || { echo "$me: --units expects a comma-separated list of units (or none)" >&2; exit 2; }
     IFS=, read -r -a req <<<"$list"
     for u in "${req[@]}"; do
