@@ -1519,6 +1519,38 @@ static void reject_combinations_nodepair(gen_t *g, int decode) {
                 emit_decode_pair(g, &nd.ctx, out, nw);
             }
         }
+    /* Generator 6, after the clean-room RTLs (docs/gateware.md): p^ is 0 for
+     * every shift parent_scale - scale >= N the ports allow.  A tree's own
+     * contexts have shifts <= N, so no earlier node-pair vector had one of 16
+     * or more, and a p^ built from the shift's low four bits passed.  Shifts
+     * N, N + 1 and 15 ... 130 (those that keep parent_scale <= 126), with a
+     * nonzero node lower-bound code on every axis, and the shift differing
+     * per axis; children a few cells wide at the child scale.  The decoder
+     * gets the encoder's words under the same context. */
+    static const int wide[] = {0, 1, 15, 16, 17, 20, 31, 32, 33, 48, 63, 64, 65, 96, 127, 128, 129, 130};
+    for (size_t i = 0; i < sizeof wide / sizeof wide[0]; i++) {
+        int sh = wide[i] < 2 ? g->N + wide[i] : wide[i];
+        int e = CBVH_SCALE_CEIL - sh - 2 < -4 ? CBVH_SCALE_CEIL - sh - 2 : -4;
+        if (e < g->ms) continue;
+        node_t nd;
+        child_t ch[2];
+        for (int a = 0; a < 3; a++) {
+            static const uint32_t lbm[3] = {1u, 0xFFFFFFFFu, 0x5u};
+            nd.ctx.axis[a] = (cbvh_axis_ctx){e + sh + a, e, lbm[a] & g->mask, a == 1 ? mkf(1, e + 3, 0) : 0};
+            for (int c = 0; c < 2; c++)
+                ch[c].b[a] = (box_t){mkf(0, e + 2, c ? 0x400000u : 0), mkf(0, e + 3, c ? 0 : 0x200000u)};
+        }
+        ch[0].flags = 0, ch[0].ptr = 5; /* inner */
+        ch[1].flags = 1, ch[1].ptr = 9; /* leaf */
+        if (!decode) {
+            emit_encode(g, &nd, ch);
+            continue;
+        }
+        uint32_t in[28], out[8];
+        encode_inputs(&nd, ch, in);
+        enc_unit->eval(&g->spec->cfg, in, out);
+        emit_decode_pair(g, &nd.ctx, out, nw);
+    }
 }
 
 /* Ray-box (traversal.md §3: every applicable reject bit is ORed): each
@@ -1593,6 +1625,49 @@ static void reject_combinations_ray_tri(gen_t *g) {
             for (int a = 0; a < 3; a++) d[a] = (bi == 0 ? F_ONE : big[bi]) | (dneg ? CBVH_F32_SIGN : 0);
             emit_ray_tri(g, o, d, v);
         }
+    /* Generator 6: two readings were pinned by one and two vectors only
+     * (docs/gateware.md).  (1) A hit is decided on the exact t, whose RD may
+     * be +0: the unit triangle in the plane x_k = 0 of each axis k, the
+     * origin a distance delta in front of it (or behind: a miss, or on it:
+     * t = 0, a miss) and |d_k| = D, so t = delta / D; delta / D = 2^-149
+     * exactly (t = 2^-149), just below it and far below (t = +0).
+     * (2) NaN/Inf vertices suppress ZERO_DIR: a zero direction (+-0
+     * components) with a NaN or +-Inf vertex coordinate in each vertex. */
+    static const struct {
+        cbvh_f32 delta, dk;
+    } tiny[] = {
+        {0x00000001u /* 2^-149 */, F_ONE},         {0x00000001u, 0x40000000u /* 2 */},
+        {0x00000001u, 0x7F7FFFFFu /* FLT_MAX */},    {0x00800000u /* 2^-126 */, 0x4B800000u /* 2^24 */},
+        {0x00800000u, 0x4B7FFFFFu /* pred 2^24 */}, {0x00C00000u /* 1.5 2^-126 */, 0x4B800001u},
+        {0x3F800000u /* 1 */, 0x7F7FFFFFu},          {0x00000003u /* 3 2^-149 */, 0x40400001u /* succ 3 */},
+        {0, 0x40000000u /* on the plane: t = 0 */},
+    };
+    for (int k = 0; k < 3; k++)
+        for (size_t i = 0; i < sizeof tiny / sizeof tiny[0]; i++)
+            for (int side = 0; side < 2; side++) {
+                if (side && !tiny[i].delta) continue;
+                int ka = (k + 1) % 3, kb = (k + 2) % 3;
+                cbvh_f32 v[9] = {0}, o[3], d[3] = {0, 0, 0};
+                v[3 + ka] = F_ONE; /* v1 = e_ka, v2 = e_kb, v0 = 0 */
+                v[6 + kb] = F_ONE;
+                o[ka] = 0x3E800000u; /* 0.25 */
+                o[kb] = 0x3E800000u;
+                /* side 0: origin at -delta, direction +D (t > 0); side 1: behind it */
+                o[k] = tiny[i].delta | (side ? 0 : CBVH_F32_SIGN);
+                d[k] = tiny[i].dk;
+                if (i % 2) o[k] ^= CBVH_F32_SIGN, d[k] |= CBVH_F32_SIGN; /* the mirrored ray */
+                emit_ray_tri(g, o, d, v);
+            }
+    static const cbvh_f32 bad[] = {F_QNAN, CBVH_F32_POS_INF, CBVH_F32_NEG_INF, 0x7F800001u /* sNaN */};
+    for (int pos = 0; pos < 9; pos += 4)
+        for (size_t b = 0; b < sizeof bad / sizeof bad[0]; b++)
+            for (int z = 0; z < 2; z++) {
+                cbvh_f32 o[3] = {0x3E800000u, 0x3E800000u, 0xBF800000u};
+                cbvh_f32 d[3] = {z ? CBVH_F32_SIGN : 0, 0, z ? CBVH_F32_SIGN : 0};
+                cbvh_f32 v[9] = {0, 0, 0, F_ONE, 0, 0, 0, F_ONE, 0};
+                v[pos] = bad[b];
+                emit_ray_tri(g, o, d, v);
+            }
 }
 
 static void reject_combinations_ray_sphere(gen_t *g) {
@@ -1624,6 +1699,37 @@ static void reject_combinations_ray_sphere(gen_t *g) {
         cbvh_f32 c[3] = {0, k == 3 ? pinf : 0, 0};
         cbvh_f32 r = k == 4 ? 0xBF800000u : F_ONE;
         emit_ray_sphere(g, o, d, 0x40000000u /* 2 */, F_ONE, c, r);
+    }
+    /* Generator 6: the accumulator's top words.  A 33-word (1,056-bit)
+     * accumulator failed one level-1 vector and a 32-word one three
+     * (docs/gateware.md): few vectors had an exact sum near the 1,115 bits of
+     * §10.1.  Every input here has an exponent in 120..127 (tmin, tmax too),
+     * so |w x d|^2, R A and |t d - w|^2 are near 2^510, 2^1106 in the unit of
+     * 2^-596: the sign of each decision sits in the top words.  A stream of
+     * its own (fixed seed); every fourth a segment [0, +Inf), otherwise a
+     * segment around, before or after t*; every other one with o and c
+     * within 2^122 of the origin and r >= 2^126 (mostly hits). */
+    rng_t hr;
+    rng_seed(&hr, UINT64_C(0x5A1E5C0FFEE00006));
+    for (int k = 0; k < 48; k++) {
+        cbvh_f32 o[3], d[3], c[3], r, t0, t1;
+        int top = k % 2 ? 121 : 127; /* odd k: |w| < 2^123 <= r, mostly hits */
+#define HUGE_F(sg, hi) mkf((sg), (int)rnd_range(&hr, 120, (hi)), (uint32_t)rng_next(&hr))
+        for (int a = 0; a < 3; a++) {
+            o[a] = HUGE_F((int)rnd_below(&hr, 2), top);
+            d[a] = HUGE_F((int)rnd_below(&hr, 2), 127);
+            c[a] = HUGE_F((int)rnd_below(&hr, 2), top);
+        }
+        r = k % 2 ? mkf(0, 126, (uint32_t)rng_next(&hr)) : HUGE_F(0, 127);
+        t0 = HUGE_F((int)rnd_below(&hr, 2), 127);
+        t1 = HUGE_F(0, 127);
+#undef HUGE_F
+        if (k % 4 == 0) t0 = 0, t1 = CBVH_F32_POS_INF;
+        else if (cbvh_f32_cmp(t0, t1) > 0) {
+            cbvh_f32 x = t0;
+            t0 = t1, t1 = x;
+        }
+        emit_ray_sphere(g, o, d, t0, t1, c, r);
     }
 }
 
