@@ -6,8 +6,6 @@ module tb_axis_compressor;
     parameter integer N     = 6;
     parameter integer E_MIN = -30;
 
-    localparam integer LW = 8 * 512;      // line buffer, bits
-
     reg  [31:0]  lb, ub;
     reg  [7:0]   scale;
     wire [N-1:0] lb_mod, ub_mod;
@@ -22,8 +20,6 @@ module tb_axis_compressor;
     localparam [8*24-1:0] VF_TB = "tb_axis_compressor", VF_UNIT = "axis_compress";
     localparam integer VF_ENC = 0, VF_MODULO = 0;
     `include "vecfile.vh"
-
-    reg [LW-1:0] extra;
     integer nf;
     reg [31:0] i_lb, i_ub, x_clb, x_cub;
     reg [31:0] i_sc, x_lm, x_um, x_cs, x_st;
@@ -34,10 +30,10 @@ module tb_axis_compressor;
         // vectors: lb ub scale -> lb_mod ub_mod child_scale clb cub status
         vf_read_line;
         while (vf_rc != 0) begin
-            // 9 hex fields; 'extra' catches a tenth one
-            extra = {LW{1'b0}};
-            nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %s",
-                         i_lb, i_ub, i_sc, x_lm, x_um, x_cs, x_clb, x_cub, x_st, extra);
+            // 9 hex fields, no more
+            {i_lb, i_ub, i_sc, x_lm, x_um, x_cs, x_clb, x_cub, x_st} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8]};
+            nf = vf_nw;
             if (nf != 9)
                 $fatal(1, "tb_axis_compressor: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             lb = i_lb; ub = i_ub; scale = i_sc[7:0];

@@ -36,9 +36,10 @@ module tb_axis_decoder;
         // vectors
         vf_read_line;
         while (vf_rc != 0) begin
-            if ($sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h",
-                        i_ps, i_sc, i_nlm, i_nclb, i_lb, i_ub,
-                        x_lb_mod, x_ub_mod, x_cs, x_clb, x_cub, x_status) != 12)
+            {i_ps, i_sc, i_nlm, i_nclb, i_lb, i_ub, x_lb_mod, x_ub_mod, x_cs, x_clb, x_cub, x_status} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
+                vf_w[10], vf_w[11]};
+            if (vf_nw != 12)
                 $fatal(1, "tb_axis_decoder: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             parent_scale = i_ps[7:0];
             scale        = i_sc[7:0];

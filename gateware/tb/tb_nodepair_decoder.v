@@ -87,7 +87,7 @@ module tb_nodepair_decoder;
     localparam integer VF_ENC = 1, VF_MODULO = MODULO;
     `include "vecfile.vh"
 
-    integer nf;
+    integer nf, k;
     reg bad;
     // fields as read (file fields can be wider than the ports: compare as read)
     reg [31:0] i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb, i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb, i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb;
@@ -125,38 +125,31 @@ module tb_nodepair_decoder;
     initial begin
         vf_open;
 
-        // vectors: 12 context fields, 4 (N <= 6) or 6 (N >= 7) words, 35 outputs
+        // vectors
         vf_read_line;
         while (vf_rc != 0) begin
             i_word4 = 0; i_word5 = 0;
-            if (N <= 6)
-                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
-                            i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb,
-                            i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb,
-                            i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb, i_word0,
-                            i_word1, i_word2, i_word3, e_c0_flags, e_c0_ptr, e_c0_x_lb_mod,
-                            e_c0_x_ub_mod, e_c0_x_child_scale, e_c0_x_clb, e_c0_x_cub,
-                            e_c0_y_lb_mod, e_c0_y_ub_mod, e_c0_y_child_scale, e_c0_y_clb,
-                            e_c0_y_cub, e_c0_z_lb_mod, e_c0_z_ub_mod, e_c0_z_child_scale,
-                            e_c0_z_clb, e_c0_z_cub, e_c1_flags, e_c1_ptr, e_c1_x_lb_mod,
-                            e_c1_x_ub_mod, e_c1_x_child_scale, e_c1_x_clb, e_c1_x_cub,
-                            e_c1_y_lb_mod, e_c1_y_ub_mod, e_c1_y_child_scale, e_c1_y_clb,
-                            e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod, e_c1_z_child_scale,
-                            e_c1_z_clb, e_c1_z_cub, e_status) - 51;
-            else
-                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
-                            i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb,
-                            i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb,
-                            i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb, i_word0,
-                            i_word1, i_word2, i_word3, i_word4, i_word5, e_c0_flags, e_c0_ptr,
-                            e_c0_x_lb_mod, e_c0_x_ub_mod, e_c0_x_child_scale, e_c0_x_clb,
-                            e_c0_x_cub, e_c0_y_lb_mod, e_c0_y_ub_mod, e_c0_y_child_scale,
-                            e_c0_y_clb, e_c0_y_cub, e_c0_z_lb_mod, e_c0_z_ub_mod,
-                            e_c0_z_child_scale, e_c0_z_clb, e_c0_z_cub, e_c1_flags, e_c1_ptr,
-                            e_c1_x_lb_mod, e_c1_x_ub_mod, e_c1_x_child_scale, e_c1_x_clb,
-                            e_c1_x_cub, e_c1_y_lb_mod, e_c1_y_ub_mod, e_c1_y_child_scale,
-                            e_c1_y_clb, e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod,
-                            e_c1_z_child_scale, e_c1_z_clb, e_c1_z_cub, e_status) - 53;
+            // 12 context fields, 4 (N <= 6) or 6 (N >= 7) words, 35 outputs, no more
+            nf = vf_nw - (N <= 6 ? 51 : 53);
+            {i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb, i_y_parent_scale, i_y_scale,
+                i_y_node_lb_mod, i_y_node_clb, i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
+                vf_w[10], vf_w[11]};
+            {i_word0, i_word1, i_word2, i_word3} = {vf_w[12], vf_w[13], vf_w[14], vf_w[15]};
+            if (N > 6) {i_word4, i_word5} = {vf_w[16], vf_w[17]};
+            k = N <= 6 ? 16 : 18;  // the first output field
+            {e_c0_flags, e_c0_ptr, e_c0_x_lb_mod, e_c0_x_ub_mod, e_c0_x_child_scale, e_c0_x_clb, e_c0_x_cub,
+                e_c0_y_lb_mod, e_c0_y_ub_mod, e_c0_y_child_scale, e_c0_y_clb, e_c0_y_cub, e_c0_z_lb_mod,
+                e_c0_z_ub_mod, e_c0_z_child_scale, e_c0_z_clb, e_c0_z_cub, e_c1_flags, e_c1_ptr,
+                e_c1_x_lb_mod, e_c1_x_ub_mod, e_c1_x_child_scale, e_c1_x_clb, e_c1_x_cub, e_c1_y_lb_mod,
+                e_c1_y_ub_mod, e_c1_y_child_scale, e_c1_y_clb, e_c1_y_cub, e_c1_z_lb_mod, e_c1_z_ub_mod,
+                e_c1_z_child_scale, e_c1_z_clb, e_c1_z_cub, e_status} =
+                {vf_w[k + 0], vf_w[k + 1], vf_w[k + 2], vf_w[k + 3], vf_w[k + 4], vf_w[k + 5], vf_w[k + 6],
+                vf_w[k + 7], vf_w[k + 8], vf_w[k + 9], vf_w[k + 10], vf_w[k + 11], vf_w[k + 12],
+                vf_w[k + 13], vf_w[k + 14], vf_w[k + 15], vf_w[k + 16], vf_w[k + 17], vf_w[k + 18],
+                vf_w[k + 19], vf_w[k + 20], vf_w[k + 21], vf_w[k + 22], vf_w[k + 23], vf_w[k + 24],
+                vf_w[k + 25], vf_w[k + 26], vf_w[k + 27], vf_w[k + 28], vf_w[k + 29], vf_w[k + 30],
+                vf_w[k + 31], vf_w[k + 32], vf_w[k + 33], vf_w[k + 34]};
             if (nf != 0)
                 $fatal(1, "tb_nodepair_decoder: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             x_parent_scale   = i_x_parent_scale[7:0];

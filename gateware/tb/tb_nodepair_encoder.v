@@ -7,8 +7,6 @@ module tb_nodepair_encoder;
     parameter integer N      = 6;
     parameter integer E_MIN  = -30;
     parameter integer MODULO = 1;
-
-    localparam integer LW  = 8 * 512;                // line buffer, bits
     localparam integer NWO = (N <= 6) ? 4 : 6;       // output words in the file
     localparam integer NIN = 28;                     // input fields
 
@@ -78,8 +76,6 @@ module tb_nodepair_encoder;
     localparam [8*24-1:0] VF_TB = "tb_nodepair_encoder", VF_UNIT = "nodepair_encode";
     localparam integer VF_ENC = 1, VF_MODULO = MODULO;
     `include "vecfile.vh"
-
-    reg [LW-1:0]     extra;
     reg [31:0]       v [0:35];                       // the fields of one vector line
     reg [31:0]       got [0:5];
     integer nf, j, bad;
@@ -90,23 +86,11 @@ module tb_nodepair_encoder;
         // vectors: 28 input fields, then NWO words and status
         vf_read_line;
         while (vf_rc != 0) begin
-            // NIN + NWO + 1 hex fields (inputs, words, status); 'extra' catches one more
-            extra = {LW{1'b0}};
+            // NIN + NWO + 1 hex fields (inputs, words, status), no more (vf_read_line split them)
             for (j = 0; j < 36; j = j + 1) v[j] = 32'd0;
-            if (NWO == 4)
-                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
-                             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
-                             v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15],
-                             v[16], v[17], v[18], v[19], v[20], v[21], v[22], v[23],
-                             v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31],
-                             v[32], extra);
-            else
-                nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
-                             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
-                             v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15],
-                             v[16], v[17], v[18], v[19], v[20], v[21], v[22], v[23],
-                             v[24], v[25], v[26], v[27], v[28], v[29], v[30], v[31],
-                             v[32], v[33], v[34], extra);
+            nf = vf_nw;
+            for (j = 0; j < 36; j = j + 1)
+                if (j < nf) v[j] = vf_w[j];
             if (nf != NIN + NWO + 1)
                 $fatal(1, "tb_nodepair_encoder: %0s:%0d: malformed vector line (%0d fields)", vf_path, vf_lineno, nf);
             x_parent_scale = v[0][7:0];

@@ -8,8 +8,6 @@ module tb_qbvh_stack;
     parameter integer N     = 6;
     parameter integer E_MIN = -30;
 
-    localparam integer LW = 8 * 256;   // line buffer: 256 characters
-
     reg  [3:0]  op, hit_mask;
     reg  [31:0] first, t0, t1, t2, t3, entry;
     wire [31:0] node, next_entry;
@@ -31,7 +29,6 @@ module tb_qbvh_stack;
 
     reg [31:0] v_op, v_first, v_mask, v_t0, v_t1, v_t2, v_t3, v_entry;
     reg [31:0] v_node, v_next, v_write, v_order, v_nhit, v_status;
-    reg [LW-1:0] extra;
     integer nf;
 
 
@@ -42,13 +39,13 @@ module tb_qbvh_stack;
         // (the "->" is only in the fields header)
         vf_read_line;
         while (vf_rc != 0) begin
-            vf_line = vf_chomp(vf_line);
-            extra = 0;
-            nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
-                         v_op, v_first, v_mask, v_t0, v_t1, v_t2, v_t3, v_entry,
-                         v_node, v_next, v_write, v_order, v_nhit, v_status, extra);
+            {v_op, v_first, v_mask, v_t0, v_t1, v_t2, v_t3, v_entry, v_node, v_next, v_write, v_order,
+                v_nhit, v_status} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
+                vf_w[10], vf_w[11], vf_w[12], vf_w[13]};
+            nf = vf_nw;
             if (nf != 14)
-                $fatal(1, "tb_qbvh_stack: %0s:%0d: malformed vector line '%0s'", vf_path, vf_lineno, vf_line);
+                $fatal(1, "tb_qbvh_stack: %0s:%0d: malformed vector line '%0s'", vf_path, vf_lineno, vf_text(64));
             // inputs wider than their port cannot be driven faithfully
             if (v_op[31:4] != 0 || v_mask[31:4] != 0)
                 $fatal(1, "tb_qbvh_stack: %0s:%0d: op or hit_mask wider than 4 bits", vf_path, vf_lineno);

@@ -55,10 +55,12 @@ module tb_ray_box;
 
         vf_read_line;
         while (vf_rc != 0) begin
-            if ($sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h %h",
-                        i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant,
-                        i_xu, i_xe, i_xr, i_xs, i_yu, i_ye, i_yr, i_ys, i_zu, i_ze, i_zr, i_zs,
-                        x_hit, x_tn, x_tf, x_status) != 25)
+            {i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_mant, i_xu, i_xe, i_xr, i_xs, i_yu, i_ye,
+                i_yr, i_ys, i_zu, i_ze, i_zr, i_zs, x_hit, x_tn, x_tf, x_status} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
+                vf_w[10], vf_w[11], vf_w[12], vf_w[13], vf_w[14], vf_w[15], vf_w[16], vf_w[17], vf_w[18],
+                vf_w[19], vf_w[20], vf_w[21], vf_w[22], vf_w[23], vf_w[24]};
+            if (vf_nw != 25)
                 $fatal(1, "tb_ray_box: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             ox = i_ox; oy = i_oy; oz = i_oz; dx = i_dx; dy = i_dy; dz = i_dz;
             tmin = i_tmin; tmax = i_tmax; mant = i_mant[7:0];

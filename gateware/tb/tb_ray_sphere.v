@@ -37,7 +37,6 @@ module tb_ray_sphere;
     integer cyc, cyc_min, cyc_max, cyc_sum, nf;
     reg [31:0] i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_cx, i_cy, i_cz, i_r;
     reg [31:0] x_hit, x_status;
-    reg [8*64-1:0] extra;
 
     initial begin
         vf_open;
@@ -50,11 +49,10 @@ module tb_ray_sphere;
         // "OX OY OZ DX DY DZ TMIN TMAX CX CY CZ R HIT STATUS"
         vf_read_line;
         while (vf_rc != 0) begin
-            vf_line = vf_chomp(vf_line);
-            extra = 0;
-            nf = $sscanf(vf_line, "%h %h %h %h %h %h %h %h %h %h %h %h %h %h %s",
-                         i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_cx, i_cy, i_cz, i_r,
-                         x_hit, x_status, extra);
+            {i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_cx, i_cy, i_cz, i_r, x_hit, x_status} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
+                vf_w[10], vf_w[11], vf_w[12], vf_w[13]};
+            nf = vf_nw;
             if (nf != 14)
                 $fatal(1, "tb_ray_sphere: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             ox = i_ox; oy = i_oy; oz = i_oz; dx = i_dx; dy = i_dy; dz = i_dz;

@@ -6,8 +6,6 @@ module tb_scale_estimator;
     parameter integer N     = 6;
     parameter integer E_MIN = -30;
 
-    localparam integer LW = 8 * 256;   // line buffer: 256 characters
-
     reg  [31:0] lb, ub;
     wire [7:0]  scale;
     wire [6:0]  status;
@@ -21,7 +19,6 @@ module tb_scale_estimator;
     `include "vecfile.vh"
 
     reg [31:0] v_lb, v_ub, v_scale, v_status;
-    reg [LW-1:0] extra;
     integer nf;
 
 
@@ -31,11 +28,10 @@ module tb_scale_estimator;
         // ---- vectors: "LB UB SCALE STATUS" (the "->" is only in the fields header)
         vf_read_line;
         while (vf_rc != 0) begin
-            vf_line = vf_chomp(vf_line);
-            extra = 0;
-            nf = $sscanf(vf_line, "%h %h %h %h %s", v_lb, v_ub, v_scale, v_status, extra);
+            {v_lb, v_ub, v_scale, v_status} = {vf_w[0], vf_w[1], vf_w[2], vf_w[3]};
+            nf = vf_nw;
             if (nf != 4)
-                $fatal(1, "tb_scale_estimator: %0s:%0d: malformed vector line '%0s'", vf_path, vf_lineno, vf_line);
+                $fatal(1, "tb_scale_estimator: %0s:%0d: malformed vector line '%0s'", vf_path, vf_lineno, vf_text(64));
             lb = v_lb;
             ub = v_ub;
             #1;
