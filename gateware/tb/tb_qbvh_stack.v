@@ -45,7 +45,7 @@ module tb_qbvh_stack;
                 vf_w[10], vf_w[11], vf_w[12], vf_w[13]};
             nf = vf_nw;
             if (nf != 14)
-                $fatal(1, "tb_qbvh_stack: %0s:%0d: malformed vector line '%0s'", vf_path, vf_lineno, vf_text(64));
+                $fatal(1, "tb_qbvh_stack: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             // inputs wider than their port cannot be driven faithfully
             if (v_op[31:4] != 0 || v_mask[31:4] != 0)
                 $fatal(1, "tb_qbvh_stack: %0s:%0d: op or hit_mask wider than 4 bits", vf_path, vf_lineno);

@@ -31,7 +31,7 @@ module tb_scale_estimator;
             {v_lb, v_ub, v_scale, v_status} = {vf_w[0], vf_w[1], vf_w[2], vf_w[3]};
             nf = vf_nw;
             if (nf != 4)
-                $fatal(1, "tb_scale_estimator: %0s:%0d: malformed vector line '%0s'", vf_path, vf_lineno, vf_text(64));
+                $fatal(1, "tb_scale_estimator: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             lb = v_lb;
             ub = v_ub;
             #1;

@@ -99,7 +99,7 @@
         end
     endtask
 
-    // the line's first n <= 64 characters as a string (header, messages)
+    // a header line's first n <= 64 characters as a string
     function [8*64-1:0] vf_text;
         input integer n;
         integer i;
