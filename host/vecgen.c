@@ -1586,6 +1586,21 @@ static void reject_combinations_ray_box(gen_t *g) {
         emit_ray_box(g, on_face, dneg, CBVH_F32_SIGN, 0, m, u, e, r, sv);
         emit_ray_box(g, inside, dpos, CBVH_F32_SIGN, CBVH_F32_SIGN, m, u, e, r, sv); /* empty interval [-0, -0] */
     }
+    /* Generator 6: the code range's upper end, 1024 (s = 2^N at N = 10) valid
+     * and 1025 BAD_CODE (not INVERTED), on each axis.  The codes above were
+     * 8, 0x800, 0x801 and 0xFFF only, so an RTL whose range check let
+     * s = 1025 through passed (gateware/scripts/mutate-rtl, docs/gateware.md).
+     * Grid 2^-10 from u = 0 on the axis under test, so [r, s] is inside
+     * [0, 1.0009765625]; the ray crosses the box. */
+    static const uint32_t lim[][2] = {{0, 1024}, {1023, 1024}, {0, 1025}, {1024, 1025}, {1025, 1024}, {1024, 1024}};
+    for (int a = 0; a < 3; a++)
+        for (size_t i = 0; i < sizeof lim / sizeof lim[0]; i++) {
+            int ea[3] = {-3, -3, -3};
+            uint32_t ra[3] = {0, 0, 0}, sa[3] = {8, 8, 8};
+            ea[a] = -10, ra[a] = lim[i][0], sa[a] = lim[i][1];
+            const cbvh_f32 o[3] = {0xBF800000u, 0xBF800000u, 0xBF800000u} /* -1 */, d[3] = {F_ONE, F_ONE, F_ONE};
+            emit_ray_box(g, o, d, 0, pinf, 24, u, ea, ra, sa);
+        }
 }
 
 /* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
