@@ -1647,7 +1647,8 @@ static void reject_combinations_ray_tri(gen_t *g) {
      * t = 0, a miss) and |d_k| = D, so t = delta / D; delta / D = 2^-149
      * exactly (t = 2^-149), just below it and far below (t = +0).
      * (2) NaN/Inf vertices suppress ZERO_DIR: a zero direction (+-0
-     * components) with a NaN or +-Inf vertex coordinate in each vertex. */
+     * components) with a NaN or +-Inf vertex coordinate in each vertex
+     * (below). */
     static const struct {
         cbvh_f32 delta, dk;
     } tiny[] = {
@@ -1673,6 +1674,26 @@ static void reject_combinations_ray_tri(gen_t *g) {
                 if (i % 2) o[k] ^= CBVH_F32_SIGN, d[k] |= CBVH_F32_SIGN; /* the mirrored ray */
                 emit_ray_tri(g, o, d, v);
             }
+    /* (3) Every monomial at the bottom of the units' 2^-447 grid: triangles
+     * and rays of subnormals only (multiples of 2^-149), so every exact sum
+     * lies in the accumulator's two lowest 32-bit words; an RTL whose shift
+     * pass read those words as 0 passed every earlier vector
+     * (gateware/scripts/mutate-rtl).  Origin 0, the triangle in the plane
+     * z = 2^-149 k around the z axis, d = (0, 0, 2^-149 m): t = k / m. */
+    static const int km[][2] = {{1, 1}, {1, 2}, {3, 1}, {2, 3}, {5, 4}, {7, 7}};
+    for (size_t i = 0; i < sizeof km / sizeof km[0]; i++)
+        for (int w = 0; w < 2; w++) {
+            cbvh_f32 o[3] = {0, 0, 0}, d[3] = {0, 0, (cbvh_f32)km[i][1]};
+            cbvh_f32 z = (cbvh_f32)km[i][0];
+            cbvh_f32 v[9] = {CBVH_F32_SIGN | 3u, CBVH_F32_SIGN | 3u, z, 5u, CBVH_F32_SIGN | 3u, z,
+                             CBVH_F32_SIGN | 3u, 5u, z};
+            if (w) { /* the other winding, and the direction's x and y tiny too */
+                cbvh_f32 t0 = v[3], t1 = v[4];
+                v[3] = v[6], v[4] = v[7], v[6] = t0, v[7] = t1;
+                d[0] = 1u, d[1] = CBVH_F32_SIGN | 1u;
+            }
+            emit_ray_tri(g, o, d, v);
+        }
     static const cbvh_f32 bad[] = {F_QNAN, CBVH_F32_POS_INF, CBVH_F32_NEG_INF, 0x7F800001u /* sNaN */};
     for (int pos = 0; pos < 9; pos += 4)
         for (size_t b = 0; b < sizeof bad / sizeof bad[0]; b++)
