@@ -285,6 +285,26 @@ static void gen_estimate(gen_t *g, size_t target) {
     }
 }
 
+/* Generator 6: a bound's last bit shifted out when the two are aligned.  A
+ * bound far below the other's last bit is cut off, and only its sticky bit
+ * can tell w = ub - lb from the width without it: ub just below 2^k and lb
+ * = -2^j one to four binades below ub's last bit (and mirrored), so w is
+ * just below or just above 2^k.  An RTL whose sticky bit ignored the last
+ * bit shifted out failed one level-2 vector only (gateware/scripts/mutate-rtl). */
+static void appended_estimate(gen_t *g) {
+    static const int ks[] = {-20, 0, 13, 40, 100};
+    for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++)
+        for (int d = 1; d <= 4; d++)
+            for (int m = 0; m < 2; m++) {
+                cbvh_f32 big = cbvh_f32_next_down(mkf(0, ks[i], 0)); /* pred(2^k) */
+                cbvh_f32 small = mkf(1, ks[i] - 24 - d, 0);        /* -2^(k-24-d) */
+                if (m)
+                    emit_box2(g, neg(big), neg(small)); /* [-pred(2^k), 2^(k-24-d)] */
+                else
+                    emit_box2(g, small, big);
+            }
+}
+
 /* ---- axis_compress --------------------------------------------------------- */
 
 static void emit_compress(gen_t *g, cbvh_f32 lo, cbvh_f32 hi, int e) {
@@ -1694,6 +1714,21 @@ static void reject_combinations_ray_tri(gen_t *g) {
             }
             emit_ray_tri(g, o, d, v);
         }
+    /* (4) t with exponent 127, in [2^127, 2^128): the largest finite range,
+     * next to §2's directed overflow (t >= 2^128 gives FLT_MAX); no earlier
+     * vector had one, and an RTL that took exponent 127 for an overflow
+     * failed level 2 only.  The unit triangle around the z axis in the plane
+     * z = Z, d = (0, 0, D): t = Z / D. */
+    static const cbvh_f32 zd[][2] = {
+        {0x7E800000u /* 2^126 */, 0x3F000000u /* 0.5: t = 2^127 */},  {0x7E800000u, 0x3EC00000u /* 0.375 */},
+        {0x7E800000u, 0x3EFFFFFFu /* pred 0.5 */},                      {0x7F7FFFFFu /* FLT_MAX */, F_ONE},
+        {0x7F7FFFFFu, 0x3F800001u /* succ 1 */},                         {0x7F7FFFFFu, 0x3FC00000u /* 1.5 */},
+    };
+    for (size_t i = 0; i < sizeof zd / sizeof zd[0]; i++) {
+        cbvh_f32 o[3] = {0, 0, 0}, d[3] = {0, 0, zd[i][1]}, z = zd[i][0];
+        cbvh_f32 v[9] = {0xBF800000u, 0xBF800000u, z, 0x40000000u, 0xBF800000u, z, 0xBF800000u, 0x40000000u, z};
+        emit_ray_tri(g, o, d, v);
+    }
     static const cbvh_f32 bad[] = {F_QNAN, CBVH_F32_POS_INF, CBVH_F32_NEG_INF, 0x7F800001u /* sNaN */};
     for (int pos = 0; pos < 9; pos += 4)
         for (size_t b = 0; b < sizeof bad / sizeof bad[0]; b++)
@@ -1776,7 +1811,8 @@ static void reject_combinations_decode_pair(gen_t *g) { reject_combinations_node
 
 /* Per unit: the size of a level-1 file before the appended cases (the
  * committed set stays small), its generator, the exact-path cases of the ray
- * units (generator 2) and the reject combinations (generator 3). */
+ * units (generator 2) and the reject combinations (generator 3) or other
+ * structured cases appended later (generator 6). */
 typedef struct {
     const char *unit;
     size_t level1;
@@ -1787,7 +1823,7 @@ typedef struct {
 } unit_gen;
 
 static const unit_gen unit_gens[] = {
-    {"scale_estimate", 2000, gen_estimate, NULL, 0, NULL},
+    {"scale_estimate", 2000, gen_estimate, NULL, 0, appended_estimate},
     {"axis_compress", 2000, gen_compress, NULL, 0, reject_combinations_compress},
     {"axis_decode", 1500, gen_decode, NULL, 0, reject_combinations_decode},
     {"nodepair_encode", 500, gen_encode_pair, NULL, 0, reject_combinations_encode_pair},
