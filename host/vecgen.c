@@ -1621,6 +1621,20 @@ static void reject_combinations_ray_box(gen_t *g) {
             const cbvh_f32 o[3] = {0xBF800000u, 0xBF800000u, 0xBF800000u} /* -1 */, d[3] = {F_ONE, F_ONE, F_ONE};
             emit_ray_box(g, o, d, 0, pinf, 24, u, ea, ra, sa);
         }
+    /* Generator 6: subnormal plane bases u and origins o that decide t: the
+     * box [U, U + 8 2^-126]^3 (r = 0), o = (O, O, O), d = (1, 1, 1), so
+     * t_near = U - O, a multiple of 2^-149.  The subnormal u and o above only
+     * ever added 2^-149-sized amounts to larger terms, and an RTL placing a
+     * subnormal's significand one bit low passed (gateware/scripts/mutate-rtl). */
+    static const cbvh_f32 uo[][2] = {{3u, 0}, {0x007FFFFFu, 0}, {0, CBVH_F32_SIGN | 5u}, {7u, 2u}, {0x00400000u, 1u}};
+    for (size_t i = 0; i < sizeof uo / sizeof uo[0]; i++)
+        for (int m = 3; m <= 24; m += 21) {
+            const int es[3] = {-126, -126, -126};
+            const uint32_t rz[3] = {0, 0, 0}, s8[3] = {8, 8, 8};
+            const cbvh_f32 ub[3] = {uo[i][0], uo[i][0], uo[i][0]}, o[3] = {uo[i][1], uo[i][1], uo[i][1]};
+            const cbvh_f32 d[3] = {F_ONE, F_ONE, F_ONE};
+            emit_ray_box(g, o, d, 0, pinf, m, ub, es, rz, s8);
+        }
 }
 
 /* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
