@@ -1755,6 +1755,16 @@ static void reject_combinations_ray_tri(gen_t *g) {
             }
 }
 
+/* A binary32 with an exponent in 120..hi and a random significand, of random
+ * sign when `signed_`: one draw per statement (the order of function
+ * arguments is unspecified in C). */
+static cbvh_f32 huge_f(rng_t *r, int signed_, int hi) {
+    uint32_t frac = (uint32_t)rng_next(r);
+    int e = (int)rnd_range(r, 120, hi);
+    int sign = signed_ ? (int)rnd_below(r, 2) : 0;
+    return mkf(sign, e, frac);
+}
+
 static void reject_combinations_ray_sphere(gen_t *g) {
     const cbvh_f32 pinf = CBVH_F32_POS_INF;
     for (int k = 0; k < 32; k++) {
@@ -1799,16 +1809,15 @@ static void reject_combinations_ray_sphere(gen_t *g) {
     for (int k = 0; k < 48; k++) {
         cbvh_f32 o[3], d[3], c[3], r, t0, t1;
         int top = k % 2 ? 121 : 127; /* odd k: |w| < 2^123 <= r, mostly hits */
-#define HUGE_F(sg, hi) mkf((sg), (int)rnd_range(&hr, 120, (hi)), (uint32_t)rng_next(&hr))
         for (int a = 0; a < 3; a++) {
-            o[a] = HUGE_F((int)rnd_below(&hr, 2), top);
-            d[a] = HUGE_F((int)rnd_below(&hr, 2), 127);
-            c[a] = HUGE_F((int)rnd_below(&hr, 2), top);
+            o[a] = huge_f(&hr, 1, top);
+            d[a] = huge_f(&hr, 1, 127);
+            c[a] = huge_f(&hr, 1, top);
         }
-        r = k % 2 ? mkf(0, 126, (uint32_t)rng_next(&hr)) : HUGE_F(0, 127);
-        t0 = HUGE_F((int)rnd_below(&hr, 2), 127);
-        t1 = HUGE_F(0, 127);
-#undef HUGE_F
+        if (k % 2) r = mkf(0, 126, (uint32_t)rng_next(&hr));
+        else r = huge_f(&hr, 0, 127);
+        t0 = huge_f(&hr, 1, 127);
+        t1 = huge_f(&hr, 0, 127);
         if (k % 4 == 0) t0 = 0, t1 = CBVH_F32_POS_INF;
         else if (cbvh_f32_cmp(t0, t1) > 0) {
             cbvh_f32 x = t0;

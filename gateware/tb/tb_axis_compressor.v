@@ -20,7 +20,6 @@ module tb_axis_compressor;
     localparam [8*24-1:0] VF_TB = "tb_axis_compressor", VF_UNIT = "axis_compress";
     localparam integer VF_ENC = 0, VF_MODULO = 0;
     `include "vecfile.vh"
-    integer nf;
     reg [31:0] i_lb, i_ub, x_clb, x_cub;
     reg [31:0] i_sc, x_lm, x_um, x_cs, x_st;
 
@@ -33,8 +32,7 @@ module tb_axis_compressor;
             // 9 hex fields, no more
             {i_lb, i_ub, i_sc, x_lm, x_um, x_cs, x_clb, x_cub, x_st} =
                 {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8]};
-            nf = vf_nw;
-            if (nf != 9)
+            if (vf_nw != 9)
                 $fatal(1, "tb_axis_compressor: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             lb = i_lb; ub = i_ub; scale = i_sc[7:0];
             #1;

@@ -87,7 +87,7 @@ module tb_nodepair_decoder;
     localparam integer VF_ENC = 1, VF_MODULO = MODULO;
     `include "vecfile.vh"
 
-    integer nf, k;
+    integer k;
     reg bad;
     // fields as read (file fields can be wider than the ports: compare as read)
     reg [31:0] i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb, i_y_parent_scale, i_y_scale, i_y_node_lb_mod, i_y_node_clb, i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb;
@@ -130,7 +130,6 @@ module tb_nodepair_decoder;
         while (vf_rc != 0) begin
             i_word4 = 0; i_word5 = 0;
             // 12 context fields, 4 (N <= 6) or 6 (N >= 7) words, 35 outputs, no more
-            nf = vf_nw - (N <= 6 ? 51 : 53);
             {i_x_parent_scale, i_x_scale, i_x_node_lb_mod, i_x_node_clb, i_y_parent_scale, i_y_scale,
                 i_y_node_lb_mod, i_y_node_clb, i_z_parent_scale, i_z_scale, i_z_node_lb_mod, i_z_node_clb} =
                 {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
@@ -150,7 +149,7 @@ module tb_nodepair_decoder;
                 vf_w[k + 19], vf_w[k + 20], vf_w[k + 21], vf_w[k + 22], vf_w[k + 23], vf_w[k + 24],
                 vf_w[k + 25], vf_w[k + 26], vf_w[k + 27], vf_w[k + 28], vf_w[k + 29], vf_w[k + 30],
                 vf_w[k + 31], vf_w[k + 32], vf_w[k + 33], vf_w[k + 34]};
-            if (nf != 0)
+            if (vf_nw != (N <= 6 ? 51 : 53))
                 $fatal(1, "tb_nodepair_decoder: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             x_parent_scale   = i_x_parent_scale[7:0];
             x_scale          = i_x_scale[7:0];

@@ -78,7 +78,7 @@ module tb_nodepair_encoder;
     `include "vecfile.vh"
     reg [31:0]       v [0:35];                       // the fields of one vector line
     reg [31:0]       got [0:5];
-    integer nf, j, bad;
+    integer j, bad;
 
     initial begin
         vf_open;
@@ -87,12 +87,9 @@ module tb_nodepair_encoder;
         vf_read_line;
         while (vf_rc != 0) begin
             // NIN + NWO + 1 hex fields (inputs, words, status), no more (vf_read_line split them)
-            for (j = 0; j < 36; j = j + 1) v[j] = 32'd0;
-            nf = vf_nw;
-            for (j = 0; j < 36; j = j + 1)
-                if (j < nf) v[j] = vf_w[j];
-            if (nf != NIN + NWO + 1)
-                $fatal(1, "tb_nodepair_encoder: %0s:%0d: malformed vector line (%0d fields)", vf_path, vf_lineno, nf);
+            for (j = 0; j < 36; j = j + 1) v[j] = (j < vf_nw) ? vf_w[j] : 32'd0;
+            if (vf_nw != NIN + NWO + 1)
+                $fatal(1, "tb_nodepair_encoder: %0s:%0d: malformed vector line (%0d fields)", vf_path, vf_lineno, vf_nw);
             x_parent_scale = v[0][7:0];
             x_scale = v[1][7:0];
             x_node_lb_mod = v[2][11:0];

@@ -29,7 +29,6 @@ module tb_qbvh_stack;
 
     reg [31:0] v_op, v_first, v_mask, v_t0, v_t1, v_t2, v_t3, v_entry;
     reg [31:0] v_node, v_next, v_write, v_order, v_nhit, v_status;
-    integer nf;
 
 
     initial begin
@@ -43,8 +42,7 @@ module tb_qbvh_stack;
                 v_nhit, v_status} =
                 {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
                 vf_w[10], vf_w[11], vf_w[12], vf_w[13]};
-            nf = vf_nw;
-            if (nf != 14)
+            if (vf_nw != 14)
                 $fatal(1, "tb_qbvh_stack: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             // inputs wider than their port cannot be driven faithfully
             if (v_op[31:4] != 0 || v_mask[31:4] != 0)

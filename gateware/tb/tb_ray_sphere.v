@@ -34,7 +34,7 @@ module tb_ray_sphere;
     localparam integer VF_ENC = 0, VF_MODULO = 0;
     `include "vecfile.vh"
 
-    integer cyc, cyc_min, cyc_max, cyc_sum, nf;
+    integer cyc, cyc_min, cyc_max, cyc_sum;
     reg [31:0] i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_cx, i_cy, i_cz, i_r;
     reg [31:0] x_hit, x_status;
 
@@ -52,8 +52,7 @@ module tb_ray_sphere;
             {i_ox, i_oy, i_oz, i_dx, i_dy, i_dz, i_tmin, i_tmax, i_cx, i_cy, i_cz, i_r, x_hit, x_status} =
                 {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
                 vf_w[10], vf_w[11], vf_w[12], vf_w[13]};
-            nf = vf_nw;
-            if (nf != 14)
+            if (vf_nw != 14)
                 $fatal(1, "tb_ray_sphere: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             ox = i_ox; oy = i_oy; oz = i_oz; dx = i_dx; dy = i_dy; dz = i_dz;
             tmin = i_tmin; tmax = i_tmax; cx = i_cx; cy = i_cy; cz = i_cz; r = i_r;

@@ -36,7 +36,7 @@ module tb_ray_triangle;
     localparam integer VF_ENC = 0, VF_MODULO = 0;
     `include "vecfile.vh"
 
-    integer cyc, cyc_min, cyc_max, cyc_sum, nf;
+    integer cyc, cyc_min, cyc_max, cyc_sum;
     reg [31:0] i_ox, i_oy, i_oz, i_dx, i_dy, i_dz;
     reg [31:0] i_v0x, i_v0y, i_v0z, i_v1x, i_v1y, i_v1z, i_v2x, i_v2y, i_v2z;
     reg [31:0] x_hit, x_t, x_b1, x_b2, x_status;
@@ -57,8 +57,7 @@ module tb_ray_triangle;
                 {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9],
                 vf_w[10], vf_w[11], vf_w[12], vf_w[13], vf_w[14], vf_w[15], vf_w[16], vf_w[17], vf_w[18],
                 vf_w[19]};
-            nf = vf_nw;
-            if (nf != 20)
+            if (vf_nw != 20)
                 $fatal(1, "tb_ray_triangle: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             ox = i_ox; oy = i_oy; oz = i_oz; dx = i_dx; dy = i_dy; dz = i_dz;
             v0x = i_v0x; v0y = i_v0y; v0z = i_v0z; v1x = i_v1x; v1y = i_v1y; v1z = i_v1z;

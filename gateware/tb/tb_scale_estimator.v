@@ -19,7 +19,6 @@ module tb_scale_estimator;
     `include "vecfile.vh"
 
     reg [31:0] v_lb, v_ub, v_scale, v_status;
-    integer nf;
 
 
     initial begin
@@ -29,8 +28,7 @@ module tb_scale_estimator;
         vf_read_line;
         while (vf_rc != 0) begin
             {v_lb, v_ub, v_scale, v_status} = {vf_w[0], vf_w[1], vf_w[2], vf_w[3]};
-            nf = vf_nw;
-            if (nf != 4)
+            if (vf_nw != 4)
                 $fatal(1, "tb_scale_estimator: %0s:%0d: malformed vector line", vf_path, vf_lineno);
             lb = v_lb;
             ub = v_ub;

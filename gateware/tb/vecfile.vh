@@ -55,7 +55,7 @@
             vf_rc = (vf_c != -1);
             while (vf_more != 0 && vf_c != -1) begin
                 if (vf_c == 0) begin                     // not a number
-                    vf_nw = -1; vf_more = 0; vf_c = 0;
+                    vf_nw = -1; vf_more = 0;
                     vf_skip_line;
                 end else begin
                     if (vf_nw >= 0 && vf_nw < VF_MAX_WORDS && vf_num[63:32] == 32'd0 && ^vf_num !== 1'bx) begin
