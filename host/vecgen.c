@@ -1635,6 +1635,18 @@ static void reject_combinations_ray_box(gen_t *g) {
             const cbvh_f32 d[3] = {F_ONE, F_ONE, F_ONE};
             emit_ray_box(g, o, d, 0, pinf, m, ub, es, rz, s8);
         }
+    /* Generator 7: INVERTED at r = s on each axis.  The x and y axes had one
+     * such vector each ((1024, 1024) above), so an RTL testing r > s there
+     * failed one vector (a third mutation run); r = s at 0, 1, 8 and 1023 and
+     * r = s + 1, in range, on each axis, the box otherwise [0, 1]^3. */
+    static const uint32_t eq[][2] = {{0, 0}, {1, 1}, {8, 8}, {1023, 1023}, {9, 8}};
+    for (int a = 0; a < 3; a++)
+        for (size_t i = 0; i < sizeof eq / sizeof eq[0]; i++) {
+            int ea[3] = {-3, -3, -3};
+            uint32_t ra[3] = {0, 0, 0}, sa[3] = {8, 8, 8};
+            ea[a] = -10, ra[a] = eq[i][0], sa[a] = eq[i][1];
+            emit_ray_box(g, inside, dpos, 0, pinf, 24, u, ea, ra, sa);
+        }
 }
 
 /* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
@@ -1765,6 +1777,78 @@ static cbvh_f32 huge_f(rng_t *r, int signed_, int hi) {
     return mkf(sign, e, frac);
 }
 
+/* Generator 7, after RTL mutation (docs/gateware.md): a unit that skips the
+ * monomials of a zero factor passed every vector when it took 2^-149 for 0 in
+ * r or o_x.  Here each of the 12 inputs in turn is +-2^-149 (e) and decides
+ * the hit: with that input read as 0 the answer flips.  Along axis a, across
+ * axis b, d = e_a unless said otherwise, segment [0, +Inf) unless said. */
+static void sphere_reset(cbvh_f32 o[3], cbvh_f32 d[3], cbvh_f32 c[3], int a) {
+    for (int i = 0; i < 3; i++) o[i] = d[i] = c[i] = 0;
+    d[a] = F_ONE;
+}
+
+static void sphere_smallest_deciders(gen_t *g) {
+    const cbvh_f32 pinf = CBVH_F32_POS_INF, five = 0x40A00000u;
+    const cbvh_f32 p2m140 = 0x00000200u, p2m140_less_e = 0x000001FFu; /* 2^-140, 2^-140 - e */
+    for (int a = 0; a < 3; a++)
+        for (int s = 0; s < 2; s++) {
+            const int b = (a + 1) % 3;
+            const cbvh_f32 e = s ? 0x80000001u : 0x00000001u;
+            cbvh_f32 o[3], d[3], c[3];
+            /* r = e: tangent at distance e (hit; r = 0 misses), at 2e (miss) */
+            sphere_reset(o, d, c, a);
+            c[a] = five, c[b] = e;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0x00000001u);
+            c[b] = s ? 0x80000002u : 0x00000002u;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0x00000001u);
+            /* r = e, c behind the origin by e: the end point t = 0 decides */
+            sphere_reset(o, d, c, a);
+            c[a] = 0x80000001u;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0x00000001u);
+            /* c_b = e, r = 0: the line misses c by e (miss; c_b = 0 hits) */
+            sphere_reset(o, d, c, a);
+            c[a] = five, c[b] = e;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0);
+            /* c_a = e on the point segment [0, 0] (miss; c_a = 0 hits) */
+            sphere_reset(o, d, c, a);
+            c[a] = e;
+            emit_ray_sphere(g, o, d, 0, 0, c, 0);
+            /* o_b = e across the ray (miss); o_a = e with c = 0 (+e: miss,
+             * the origin is past c; -e: before it, a hit) */
+            sphere_reset(o, d, c, a);
+            o[b] = e, c[a] = five;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0);
+            sphere_reset(o, d, c, a);
+            o[a] = e;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0);
+            /* d_b = e: the line leans off c = 5 e_a by 5e (miss; d_b = 0 hits) */
+            sphere_reset(o, d, c, a);
+            d[b] = e, c[a] = five;
+            emit_ray_sphere(g, o, d, 0, pinf, c, 0);
+            /* d = e e_a alone on [0, 1]: it reaches c = e e_a (hit) but not
+             * c = 2e e_a (miss; d = 0 would give A = 0 and |w x d|^2 = 0 <= 0) */
+            sphere_reset(o, d, c, a);
+            d[a] = e, c[a] = e;
+            emit_ray_sphere(g, o, d, 0, F_ONE, c, 0);
+            c[a] = s ? 0x80000002u : 0x00000002u;
+            emit_ray_sphere(g, o, d, 0, F_ONE, c, 0);
+            /* tmin = e beyond t* = -1 (c = -e_a, r = 1): the end point is at
+             * 1 + e (miss) for +e, 1 - e (hit) for -e; and c = -2^-140 e_a
+             * with r = 2^-140 - e: tmin = -e reaches it exactly (hit) */
+            sphere_reset(o, d, c, a);
+            c[a] = 0xBF800000u;
+            emit_ray_sphere(g, o, d, e, pinf, c, F_ONE);
+            c[a] = p2m140 | CBVH_F32_SIGN;
+            emit_ray_sphere(g, o, d, e, pinf, c, p2m140_less_e);
+            /* tmax = e before t* = 2^-140 (c = 2^-140 e_a, r = 2^-140 - e):
+             * tmax = +e reaches the sphere exactly (hit), t = 0 does not;
+             * tmax = -e < tmin is an empty segment */
+            sphere_reset(o, d, c, a);
+            c[a] = p2m140;
+            emit_ray_sphere(g, o, d, 0, e, c, p2m140_less_e);
+        }
+}
+
 static void reject_combinations_ray_sphere(gen_t *g) {
     const cbvh_f32 pinf = CBVH_F32_POS_INF;
     for (int k = 0; k < 32; k++) {
@@ -1825,6 +1909,7 @@ static void reject_combinations_ray_sphere(gen_t *g) {
         }
         emit_ray_sphere(g, o, d, t0, t1, c, r);
     }
+    sphere_smallest_deciders(g);
 }
 
 static void reject_combinations_encode_pair(gen_t *g) { reject_combinations_nodepair(g, 0); }
@@ -1835,7 +1920,7 @@ static void reject_combinations_decode_pair(gen_t *g) { reject_combinations_node
 /* Per unit: the size of a level-1 file before the appended cases (the
  * committed set stays small), its generator, the exact-path cases of the ray
  * units (generator 2) and the reject combinations (generator 3) or other
- * structured cases appended later (generator 6). */
+ * structured cases appended later (generators 6 and 7). */
 typedef struct {
     const char *unit;
     size_t level1;
