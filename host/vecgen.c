@@ -1430,6 +1430,34 @@ static void reject_combinations_compress(gen_t *g) {
         for (size_t e = 0; e < sizeof scales / sizeof scales[0]; e++) emit_compress(g, boxes[b][0], boxes[b][1], scales[e]);
 }
 
+/* Generator 7: node_clb far below the child grid, where the decoder's shift
+ * of u_node reaches its clamp (every bit of u_node sticky).  The alignment
+ * limits above stop at clb ~ 2^(scale-17); an RTL clamping that shift one
+ * short left u_node's top bit in the sum and passed every vector, though it
+ * gives pred(2^e) for a cub of 2^e - |clb| (a third mutation run,
+ * docs/gateware.md).  clb = +-(1.f) 2^(scale+d+23) for d = -47 .. -51 (the
+ * clamp starts at d = -49), -64 and -100, codes (r, s) = (0, 1), (1, 2),
+ * (0, 2), (2, 3) with p^ = 0: with clb < 0, s = 1 and r = 1 the sum is
+ * 2^24 - 1 units of 2^(e-24), on the binary32 grid. */
+static void decode_clb_far_below(gen_t *g) {
+    static const int ds[] = {-47, -48, -49, -50, -51, -64, -100};
+    static const uint32_t fracs[] = {0, CBVH_F32_FRAC, 0x400001u};
+    static const uint32_t rs[][2] = {{0, 1}, {1, 2}, {0, 2}, {2, 3}};
+    for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++)
+        for (size_t f = 0; f < sizeof fracs / sizeof fracs[0]; f++)
+            for (int neg = 0; neg < 2; neg++)
+                for (size_t k = 0; k < sizeof rs / sizeof rs[0]; k++) {
+                    cbvh_axis_ctx c;
+                    c.scale = g->ms + 3 > CBVH_SCALE_CEIL ? CBVH_SCALE_CEIL : g->ms + 3;
+                    c.parent_scale = c.scale;
+                    c.lb_mod = 0;
+                    int eu = c.scale + ds[i] + 150; /* biased exponent of clb */
+                    if (eu < 1 || eu > 254) continue;
+                    c.clb = (neg ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << 23 | fracs[f];
+                    emit_decode(g, &c, rs[k][0], rs[k][1]);
+                }
+}
+
 static void reject_combinations_decode(gen_t *g) {
     const uint32_t full = g->mask + 1u;
     /* A valid context: ms <= scale <= parent_scale <= 126, p^ = 0. */
@@ -1455,6 +1483,7 @@ static void reject_combinations_decode(gen_t *g) {
                         if (cc == 2) uc = 0xFFF;
                         emit_decode(g, &c, lc, uc);
                     }
+    decode_clb_far_below(g);
 }
 
 /* QBVH stack: a push with a NaN hit time and a first-child ID >= 2^26 (NAN_INF
