@@ -1667,14 +1667,18 @@ static void reject_combinations_ray_box(gen_t *g) {
     /* Generator 7: INVERTED at r = s on each axis.  The x and y axes had one
      * such vector each ((1024, 1024) above), so an RTL testing r > s there
      * failed one vector (a third mutation run); r = s at 0, 1, 8 and 1023 and
-     * r = s + 1, in range, on each axis, the box otherwise [0, 1]^3. */
-    static const uint32_t eq[][2] = {{0, 0}, {1, 1}, {8, 8}, {1023, 1023}, {9, 8}};
+     * r = s + 1, in range, on each axis, the box otherwise [0, 1]^3.  And the
+     * range ends again with M = 3 (a fourth run killed the limits r <= 1024 in
+     * BAD_CODE and s <= 1024 in INVERTED by one vector each): r = 1025 with
+     * s = 0 and 1025, s = 1026, and (1024, 1024). */
+    static const uint32_t eq[][2] = {{0, 0}, {1, 1}, {8, 8}, {1023, 1023}, {9, 8},
+                                     {1025, 0}, {1025, 1025}, {0, 1026}, {1024, 1024}};
     for (int a = 0; a < 3; a++)
         for (size_t i = 0; i < sizeof eq / sizeof eq[0]; i++) {
             int ea[3] = {-3, -3, -3};
             uint32_t ra[3] = {0, 0, 0}, sa[3] = {8, 8, 8};
             ea[a] = -10, ra[a] = eq[i][0], sa[a] = eq[i][1];
-            emit_ray_box(g, inside, dpos, 0, pinf, 24, u, ea, ra, sa);
+            emit_ray_box(g, inside, dpos, 0, pinf, i < 5 ? 24 : 3, u, ea, ra, sa);
         }
 }
 
