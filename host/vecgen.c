@@ -1686,6 +1686,41 @@ static void reject_combinations_ray_box(gen_t *g) {
  * ray-sphere (§10.2: BAD_PARAM ORed with NAN_INF or ZERO_DIR, ZERO_DIR only for
  * a ray without NaN/Inf): every combination of a NaN or Inf in the ray, a zero
  * direction (also -0 components) and a bad vertex, centre or radius. */
+/* Generator 7: quotients that tie exactly while det' and Nt span more than
+ * 800 bits, above 2^380 and below 2^-415 at once.  Two RTL slips that touch
+ * only the lowest words of the 27-word operands (the shift pass dropping the
+ * first word, the divider reading word 1 for word 0) passed every level-1
+ * and level-2 vector (a fourth mutation run, docs/gateware.md): no vector had
+ * both ends in one sum.  With v0 = 0, v1 = (h, tau, 0), v2 = (0, h, tau) and
+ * d = (k tau, 0, h), d . (v1 x v2) = k tau^3 + h^3, and o = -d (t = 1) or
+ * o = -d/2 (k = 2, t = 1/2) puts the hit on v0 with Nt = t det' exactly;
+ * tau = 2^-149 or 3 2^-149, h = 2^127 or 1.5 2^127, the axes rotated, the
+ * winding swapped and the scene mirrored through the origin. */
+static void tri_wide_ties(gen_t *g) {
+    static const cbvh_f32 taus[] = {0x00000001u, 0x00000003u}, hs[] = {0x7F000000u, 0x7F400000u};
+    for (size_t ti = 0; ti < 2; ti++)
+        for (size_t hi = 0; hi < 2; hi++)
+            for (int half = 0; half < 2; half++)
+                for (int rot = 0; rot < 3; rot++)
+                    for (int swap = 0; swap < 2; swap++)
+                        for (int mirror = 0; mirror < 2; mirror++) {
+                            const cbvh_f32 tau = taus[ti], h = hs[hi], m = mirror ? CBVH_F32_SIGN : 0;
+                            /* in the unrotated frame (x, y, z) */
+                            cbvh_f32 d0[3] = {half ? tau * 2 : tau, 0, h};
+                            cbvh_f32 o0[3] = {tau ^ CBVH_F32_SIGN, 0, (half ? h - (1u << 23) : h) ^ CBVH_F32_SIGN};
+                            cbvh_f32 a0[3] = {h, tau, 0}, b0[3] = {0, h, tau};
+                            cbvh_f32 o[3], d[3], v[9] = {0};
+                            for (int k = 0; k < 3; k++) {
+                                int a = (k + rot) % 3; /* axis k of the frame goes to axis a */
+                                o[a] = o0[k] ? o0[k] ^ m : 0;
+                                d[a] = d0[k] ? d0[k] ^ m : 0;
+                                v[3 + a] = (swap ? b0[k] : a0[k]) ? (swap ? b0[k] : a0[k]) ^ m : 0;
+                                v[6 + a] = (swap ? a0[k] : b0[k]) ? (swap ? a0[k] : b0[k]) ^ m : 0;
+                            }
+                            emit_ray_tri(g, o, d, v);
+                        }
+}
+
 static void reject_combinations_ray_tri(gen_t *g) {
     const cbvh_f32 pinf = CBVH_F32_POS_INF;
     for (int k = 0; k < 16; k++) {
@@ -1798,6 +1833,7 @@ static void reject_combinations_ray_tri(gen_t *g) {
                 v[pos] = bad[b];
                 emit_ray_tri(g, o, d, v);
             }
+    tri_wide_ties(g);
 }
 
 /* A binary32 with an exponent in 120..hi and a random significand, of random
