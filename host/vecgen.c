@@ -1682,10 +1682,6 @@ static void reject_combinations_ray_box(gen_t *g) {
         }
 }
 
-/* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
- * ray-sphere (§10.2: BAD_PARAM ORed with NAN_INF or ZERO_DIR, ZERO_DIR only for
- * a ray without NaN/Inf): every combination of a NaN or Inf in the ray, a zero
- * direction (also -0 components) and a bad vertex, centre or radius. */
 /* Generator 7: quotients that tie exactly while det' and Nt span more than
  * 800 bits, above 2^380 and below 2^-415 at once.  Two RTL slips that touch
  * only the lowest words of the 27-word operands (the shift pass dropping the
@@ -1705,22 +1701,27 @@ static void tri_wide_ties(gen_t *g) {
                     for (int swap = 0; swap < 2; swap++)
                         for (int mirror = 0; mirror < 2; mirror++) {
                             const cbvh_f32 tau = taus[ti], h = hs[hi], m = mirror ? CBVH_F32_SIGN : 0;
-                            /* in the unrotated frame (x, y, z) */
-                            cbvh_f32 d0[3] = {half ? tau * 2 : tau, 0, h};
-                            cbvh_f32 o0[3] = {tau ^ CBVH_F32_SIGN, 0, (half ? h - (1u << 23) : h) ^ CBVH_F32_SIGN};
-                            cbvh_f32 a0[3] = {h, tau, 0}, b0[3] = {0, h, tau};
+                            /* in the unrotated frame (x, y, z); h - 2^23 halves h */
+                            const cbvh_f32 d0[3] = {half ? tau * 2 : tau, 0, h};
+                            const cbvh_f32 o0[3] = {neg(tau), 0, neg(half ? h - (1u << 23) : h)};
+                            const cbvh_f32 a0[3] = {h, tau, 0}, b0[3] = {0, h, tau};
+                            const cbvh_f32 *p1 = swap ? b0 : a0, *p2 = swap ? a0 : b0;
                             cbvh_f32 o[3], d[3], v[9] = {0};
                             for (int k = 0; k < 3; k++) {
                                 int a = (k + rot) % 3; /* axis k of the frame goes to axis a */
-                                o[a] = o0[k] ? o0[k] ^ m : 0;
+                                o[a] = o0[k] ? o0[k] ^ m : 0; /* mirrored; a zero stays +0 */
                                 d[a] = d0[k] ? d0[k] ^ m : 0;
-                                v[3 + a] = (swap ? b0[k] : a0[k]) ? (swap ? b0[k] : a0[k]) ^ m : 0;
-                                v[6 + a] = (swap ? a0[k] : b0[k]) ? (swap ? a0[k] : b0[k]) ^ m : 0;
+                                v[3 + a] = p1[k] ? p1[k] ^ m : 0;
+                                v[6 + a] = p2[k] ? p2[k] ^ m : 0;
                             }
                             emit_ray_tri(g, o, d, v);
                         }
 }
 
+/* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
+ * ray-sphere (§10.2: BAD_PARAM ORed with NAN_INF or ZERO_DIR, ZERO_DIR only for
+ * a ray without NaN/Inf): every combination of a NaN or Inf in the ray, a zero
+ * direction (also -0 components) and a bad vertex, centre or radius. */
 static void reject_combinations_ray_tri(gen_t *g) {
     const cbvh_f32 pinf = CBVH_F32_POS_INF;
     for (int k = 0; k < 16; k++) {
