@@ -1718,6 +1718,64 @@ static void tri_wide_ties(gen_t *g) {
                         }
 }
 
+/* Generator 7: as for the sphere below, every input of a ray-triangle in
+ * turn is +-2^-149 (e) and decides the hit: read as 0 (a zero factor's
+ * monomials skipped) the answer flips.  In a frame (P, Q, N) of rotated axes,
+ * the triangle A = 0, B = sp e_P, C = sq e_Q in the plane N = 0, the ray
+ * along N through a point of the edge AC (P = 0) or AB (Q = 0) or inside:
+ * o_P, d_P (or o_Q, d_Q) = e move the hit point off the edge, outward (a
+ * miss); o_N = e starts the ray e before the plane (t = 2^-149 > 0, a hit;
+ * t = 0 is not); d = e e_N alone gives t = 2^149 (a hit; d_N = 0 gives
+ * det' = 0); A_P = e (A_Q) moves the edge past the hit point (a miss), and
+ * A_N = e lifts the plane to t = 2^-150 (a hit), with A each of v0, v1, v2. */
+static void tri_place(cbvh_f32 out[3], int rot, cbvh_f32 p, cbvh_f32 q, cbvh_f32 n) {
+    out[rot] = p, out[(rot + 1) % 3] = q, out[(rot + 2) % 3] = n;
+}
+
+static void tri_emit_roles(gen_t *g, int rot, const cbvh_f32 o[3], const cbvh_f32 d[3], const cbvh_f32 a[3],
+                           int sp, int sq, int cyc) {
+    cbvh_f32 oo[3], dd[3], r[3][3], v[9];
+    tri_place(oo, rot, o[0], o[1], o[2]);
+    tri_place(dd, rot, d[0], d[1], d[2]);
+    tri_place(r[0], rot, a[0], a[1], a[2]);
+    tri_place(r[1], rot, sp < 0 ? neg(F_ONE) : F_ONE, 0, 0);
+    tri_place(r[2], rot, 0, sq < 0 ? neg(F_ONE) : F_ONE, 0);
+    for (int k = 0; k < 3; k++) /* v_k = role (k + cyc) mod 3: the winding is kept */
+        for (int c = 0; c < 3; c++) v[3 * k + c] = r[(k + cyc) % 3][c];
+    emit_ray_tri(g, oo, dd, v);
+}
+
+static void tri_smallest_deciders(gen_t *g) {
+    const cbvh_f32 half = 0x3F000000u, quarter = 0x3E800000u, one = F_ONE, m1 = 0xBF800000u;
+    const cbvh_f32 zero3[3] = {0, 0, 0};
+    for (int rot = 0; rot < 3; rot++)
+        for (int si = 0; si < 2; si++) {
+            const int s = si ? -1 : 1;
+            const cbvh_f32 e = si ? 0x80000001u : 0x00000001u, sone = si ? m1 : one, msone = si ? one : m1;
+            const cbvh_f32 up[3] = {0, 0, one};
+            /* the ray's inputs, v0 = A = 0 */
+            tri_emit_roles(g, rot, (const cbvh_f32[3]){e, half, m1}, up, zero3, -s, 1, 0);          /* o_P */
+            tri_emit_roles(g, rot, (const cbvh_f32[3]){half, e, m1}, up, zero3, 1, -s, 0);          /* o_Q */
+            tri_emit_roles(g, rot, (const cbvh_f32[3]){quarter, quarter, e}, (const cbvh_f32[3]){0, 0, msone},
+                           zero3, 1, 1, 0);                                                         /* o_N */
+            tri_emit_roles(g, rot, (const cbvh_f32[3]){0, half, m1}, (const cbvh_f32[3]){e, 0, one}, zero3, -s, 1,
+                           0);                                                                      /* d_P */
+            tri_emit_roles(g, rot, (const cbvh_f32[3]){half, 0, m1}, (const cbvh_f32[3]){0, e, one}, zero3, 1, -s,
+                           0);                                                                      /* d_Q */
+            tri_emit_roles(g, rot, (const cbvh_f32[3]){quarter, quarter, msone}, (const cbvh_f32[3]){0, 0, e}, zero3,
+                           1, 1, 0);                                                                /* d_N */
+            /* the vertex A = v0, v1, v2 in turn */
+            for (int cyc = 0; cyc < 3; cyc++) {
+                tri_emit_roles(g, rot, (const cbvh_f32[3]){0, half, m1}, up, (const cbvh_f32[3]){e, 0, 0}, s, 1,
+                               cyc);                                                                /* A_P */
+                tri_emit_roles(g, rot, (const cbvh_f32[3]){half, 0, m1}, up, (const cbvh_f32[3]){0, e, 0}, 1, s,
+                               cyc);                                                                /* A_Q */
+                tri_emit_roles(g, rot, (const cbvh_f32[3]){quarter, quarter, 0}, (const cbvh_f32[3]){0, 0, sone},
+                               (const cbvh_f32[3]){0, 0, e}, 1, 1, cyc);                            /* A_N */
+            }
+        }
+}
+
 /* Ray-triangle (traversal.md §4: one bit, NAN_INF before ZERO_DIR) and
  * ray-sphere (§10.2: BAD_PARAM ORed with NAN_INF or ZERO_DIR, ZERO_DIR only for
  * a ray without NaN/Inf): every combination of a NaN or Inf in the ray, a zero
@@ -1835,6 +1893,7 @@ static void reject_combinations_ray_tri(gen_t *g) {
                 emit_ray_tri(g, o, d, v);
             }
     tri_wide_ties(g);
+    tri_smallest_deciders(g);
 }
 
 /* A binary32 with an exponent in 120..hi and a random significand, of random
