@@ -1443,19 +1443,20 @@ static void decode_clb_far_below(gen_t *g) {
     static const int ds[] = {-47, -48, -49, -50, -51, -64, -100};
     static const uint32_t fracs[] = {0, CBVH_F32_FRAC, 0x400001u};
     static const uint32_t rs[][2] = {{0, 1}, {1, 2}, {0, 2}, {2, 3}};
-    for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++)
+    cbvh_axis_ctx c;
+    c.scale = g->ms + 3 > CBVH_SCALE_CEIL ? CBVH_SCALE_CEIL : g->ms + 3;
+    c.parent_scale = c.scale;
+    c.lb_mod = 0;
+    for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++) {
+        int eu = c.scale + ds[i] + 150; /* biased exponent of clb */
+        if (eu < 1 || eu > 254) continue;
         for (size_t f = 0; f < sizeof fracs / sizeof fracs[0]; f++)
             for (int neg = 0; neg < 2; neg++)
                 for (size_t k = 0; k < sizeof rs / sizeof rs[0]; k++) {
-                    cbvh_axis_ctx c;
-                    c.scale = g->ms + 3 > CBVH_SCALE_CEIL ? CBVH_SCALE_CEIL : g->ms + 3;
-                    c.parent_scale = c.scale;
-                    c.lb_mod = 0;
-                    int eu = c.scale + ds[i] + 150; /* biased exponent of clb */
-                    if (eu < 1 || eu > 254) continue;
                     c.clb = (neg ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << 23 | fracs[f];
                     emit_decode(g, &c, rs[k][0], rs[k][1]);
                 }
+    }
 }
 
 static void reject_combinations_decode(gen_t *g) {
@@ -1922,13 +1923,13 @@ static void sphere_smallest_deciders(gen_t *g) {
     for (int a = 0; a < 3; a++)
         for (int s = 0; s < 2; s++) {
             const int b = (a + 1) % 3;
-            const cbvh_f32 e = s ? 0x80000001u : 0x00000001u;
+            const cbvh_f32 e = s ? 0x80000001u : 0x00000001u, e2 = e + 1; /* +-2^-149, +-2^-148 */
             cbvh_f32 o[3], d[3], c[3];
             /* r = e: tangent at distance e (hit; r = 0 misses), at 2e (miss) */
             sphere_reset(o, d, c, a);
             c[a] = five, c[b] = e;
             emit_ray_sphere(g, o, d, 0, pinf, c, 0x00000001u);
-            c[b] = s ? 0x80000002u : 0x00000002u;
+            c[b] = e2;
             emit_ray_sphere(g, o, d, 0, pinf, c, 0x00000001u);
             /* r = e, c behind the origin by e: the end point t = 0 decides */
             sphere_reset(o, d, c, a);
@@ -1959,7 +1960,7 @@ static void sphere_smallest_deciders(gen_t *g) {
             sphere_reset(o, d, c, a);
             d[a] = e, c[a] = e;
             emit_ray_sphere(g, o, d, 0, F_ONE, c, 0);
-            c[a] = s ? 0x80000002u : 0x00000002u;
+            c[a] = e2;
             emit_ray_sphere(g, o, d, 0, F_ONE, c, 0);
             /* tmin = e beyond t* = -1 (c = -e_a, r = 1): the end point is at
              * 1 + e (miss) for +e, 1 - e (hit) for -e; and c = -2^-140 e_a
