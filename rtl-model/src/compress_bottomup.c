@@ -21,7 +21,11 @@
  * the same 2^b cell, so re-encoding [u, pred(v)] reproduces the top-down codes
  * bit for bit.  (Likewise u = -Inf, the encoding of -2^128, is re-encoded as
  * -FLT_MAX, which lies in the same cell.)  naive_reencode = 1 re-encodes [u, v]
- * as printed, for the study.
+ * as printed, for the study; where that breaks the tree (a child grown past
+ * its node's box wraps, a bound grown to 2^128 = +Inf cannot be encoded, or
+ * an unchanged scale no longer decodes a pair's grown children) the pair is
+ * repaired with the exact rule clipped to its node's box and counted in
+ * naive_nofit, so a naive CBVH still decodes and encloses (docs/study.md).
  *
  * Treelets of depth M: pairs within M-1 levels below the node being processed
  * are still on chip, so re-encoding them is free; only deeper re-encodes are
@@ -72,6 +76,7 @@ typedef struct {
     uint32_t pair;
     int depth;
     cbvh_node_ctx old_ctx, new_ctx;
+    cbvh_f32 node_cub[3]; /* the node's decoded upper bounds under new_ctx */
 } bt_item;
 
 typedef struct {
@@ -85,10 +90,40 @@ typedef struct {
 
 #define ENC_FAIL (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT | CBVH_ST_NO_FIT)
 
-static int backtrack(bu_state *s, uint32_t pair, const cbvh_node_ctx *old_ctx, const cbvh_node_ctx *new_ctx) {
+/* naive_reencode only: 1 if the pair decodes under ctx to exactly `want`.
+ * The encoder does not check that children lie inside the node's box (the
+ * decoder's window of 2^N cells); exact re-encoding keeps them inside, a
+ * naive one may not, and then the codes wrap. */
+static int decodes_as(const bu_state *s, const cbvh_node_ctx *ctx, const uint8_t *bytes, uint32_t want_st,
+                      const cbvh_child_out want[2]) {
+    cbvh_child_out got[2];
+    memset(got, 0, sizeof got);
+    uint32_t st = cbvh_nodepair_decode(&s->o->params, s->o->enc, ctx, bytes, got);
+    return st == want_st && !(st & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT)) && !memcmp(got, want, sizeof got);
+}
+
+/* naive_reencode only.  A child whose context changed without changing its
+ * codes (ctx_differs: 0) keeps its pair; that is sound when the pair's
+ * children lie inside the child's box, as exact re-encoding guarantees.  A
+ * naive re-encode may have grown them one cell past it, and under the new
+ * context (a lower bound moved down) those codes can wrap.  1 if the pair
+ * decodes under the new context exactly as under the old one; else it is
+ * counted in naive_nofit and re-encoded like a changed context. */
+static int same_decode(bu_state *s, const bt_item *it) {
+    const uint8_t *bytes = s->t->pairs + (size_t)it->pair * s->t->pair_bytes;
+    cbvh_child_out old[2];
+    memset(old, 0, sizeof old);
+    uint32_t st = cbvh_nodepair_decode(&s->o->params, s->o->enc, &it->old_ctx, bytes, old);
+    if (decodes_as(s, &it->new_ctx, bytes, st, old)) return 1;
+    s->st->naive_nofit++;
+    return 0;
+}
+
+static int backtrack(bu_state *s, uint32_t pair, const cbvh_node_ctx *old_ctx, const cbvh_node_ctx *new_ctx,
+                     const cbvh_f32 node_cub[3]) {
     const cbvh_params *p = &s->o->params;
     uint32_t sp = 0;
-    s->stack[sp++] = (bt_item){pair, 1, *old_ctx, *new_ctx};
+    s->stack[sp++] = (bt_item){pair, 1, *old_ctx, *new_ctx, {node_cub[0], node_cub[1], node_cub[2]}};
     while (sp) {
         bt_item it = s->stack[--sp];
         uint8_t *bytes = s->t->pairs + (size_t)it.pair * s->t->pair_bytes;
@@ -119,15 +154,31 @@ static int backtrack(bu_state *s, uint32_t pair, const cbvh_node_ctx *old_ctx, c
             /* A grown child that touched its node's upper bound can land one
              * cell past the node's box: its codes wrap.  Detect it with the
              * decoder (what traversal would see) and fall back. */
-            cbvh_child_out chk[2];
-            uint32_t dst = cbvh_nodepair_decode(p, s->o->enc, &it.new_ctx, bytes, chk);
-            if ((dst & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT)) || memcmp(chk, nd, sizeof chk)) st |= CBVH_ST_NO_FIT;
+            if (!decodes_as(s, &it.new_ctx, bytes, st, nd)) st |= CBVH_ST_NO_FIT;
         }
-        if ((st & CBVH_ST_NO_FIT) && s->o->naive_reencode) {
+        /* ... or could not encode at all: a bound decoded as +Inf (2^128)
+         * is no binary32 input. */
+        if ((st & ENC_FAIL) && s->o->naive_reencode) {
             s->st->naive_nofit++;
+            /* [u, pred(v)], clipped to the node's own [., pred(v_node)]:
+             * children grown by earlier naive re-encodes can stick out of
+             * a node box that a fallback shrank again, and would wrap.
+             * Both bounds are >= the true upper bound, so the box still
+             * encloses. */
             for (int c = 0; c < 2; c++)
-                for (int a = 0; a < 3; a++) in[c].hi[a] = cbvh_f32_next_down(od[c].axis[a].cub);
+                for (int a = 0; a < 3; a++) {
+                    cbvh_f32 hi = cbvh_f32_next_down(od[c].axis[a].cub), top = cbvh_f32_next_down(it.node_cub[a]);
+                    in[c].hi[a] = cbvh_float_of(top) < cbvh_float_of(hi) ? top : hi;
+                }
             st = cbvh_nodepair_encode(p, s->o->enc, &it.new_ctx, in, bytes, nd);
+            /* a guard: with the clip the repaired pair always decodes */
+            if (!(st & ENC_FAIL) && !decodes_as(s, &it.new_ctx, bytes, st, nd)) {
+                snprintf(s->err, s->errlen,
+                         "cbvh bottom-up: naive re-encoding (as printed) left pair %u undecodable even after its "
+                         "repair; the exact rule (naive_reencode = 0) does not",
+                         it.pair);
+                return -1;
+            }
         }
         if (st & ENC_FAIL) {
             snprintf(s->err, s->errlen, "cbvh bottom-up: backtrack cannot re-encode pair %u (status 0x%x)", it.pair, st);
@@ -138,10 +189,12 @@ static int backtrack(bu_state *s, uint32_t pair, const cbvh_node_ctx *old_ctx, c
         if (it.depth >= s->o->treelet_depth) s->st->backtracks++;
         for (int c = 0; c < 2; c++) {
             if (od[c].empty || od[c].leaf) continue;
-            bt_item nx = {od[c].ptr, it.depth + 1, {{{0}}}, {{{0}}}};
+            bt_item nx = {od[c].ptr, it.depth + 1, {{{0}}}, {{{0}}},
+                          {nd[c].axis[0].cub, nd[c].axis[1].cub, nd[c].axis[2].cub}};
             cbvh_child_ctx3(&it.old_ctx, &od[c], &nx.old_ctx);
             cbvh_child_ctx3(&it.new_ctx, &nd[c], &nx.new_ctx);
-            if (ctx_differs(s->o->enc, &nx.old_ctx, &nx.new_ctx)) s->stack[sp++] = nx;
+            if (ctx_differs(s->o->enc, &nx.old_ctx, &nx.new_ctx) ||
+                (s->o->naive_reencode && !same_decode(s, &nx))) s->stack[sp++] = nx;
         }
     }
     return 0;
@@ -381,13 +434,15 @@ static inline int bu_step(cbvh_bu_stream *bs, const cbvh_bvh_node *n, const cbvh
         for (int c = 1; c >= 0; c--) {
             if (!maybe[c]) continue;
             cbvh_node_ctx stored, actual;
+            cbvh_f32 cub[3];
             rec_ctx(cr[c], &stored);
             for (int a = 0; a < 3; a++) {
                 cbvh_axis_code code;
                 cbvh_axis_compress(p, cbvh_f32_of(cn[c]->lo[a]), cbvh_f32_of(cn[c]->hi[a]), cs[a], &code);
                 actual.axis[a] = cbvh_axis_child_ctx(&(cbvh_axis_ctx){rx.ax[a].e, cs[a], rx.ax[a].lb_mod, 0}, &code);
+                cub[a] = code.cub;
             }
-            if (ctx_differs(o->enc, &stored, &actual) && backtrack(s, slot[c], &stored, &actual)) return -1;
+            if (ctx_differs(o->enc, &stored, &actual) && backtrack(s, slot[c], &stored, &actual, cub)) return -1;
         }
         sp -= inner_children;
         recs[sp++] = rx;
@@ -421,7 +476,8 @@ general:;
         cbvh_node_ctx stored, actual;
         rec_ctx(&recs[--sp], &stored);
         cbvh_child_ctx3(&est, &co[c], &actual);
-        if (ctx_differs(o->enc, &stored, &actual) && backtrack(s, in[c].ptr, &stored, &actual)) return -1;
+        const cbvh_f32 cub[3] = {co[c].axis[0].cub, co[c].axis[1].cub, co[c].axis[2].cub};
+        if (ctx_differs(o->enc, &stored, &actual) && backtrack(s, in[c].ptr, &stored, &actual, cub)) return -1;
     }
     bu_rec *r = &recs[sp++];
     rec_of_ctx(&est, r);

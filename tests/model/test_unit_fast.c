@@ -19,8 +19,9 @@
  *      statistics, on random soups with mixed magnitudes (negative, zero,
  *      subnormal, up to +-FLT_MAX), flat boxes and far-away clusters, for
  *      N = 3..10, min_scale -126/-30/-10/0, both encodings, treelet depth
- *      1 and 4 and streaming refit; naive re-encoding (which may fail or
- *      differ by design) independent of the treelet depth.
+ *      1 and 4 and streaming refit; naive re-encoding (which may differ
+ *      from top-down by design) independent of the treelet depth, never
+ *      failing and always a valid CBVH (cbvh_tree_check).
  *
  * usage: test_unit_fast [--scale S]   (S multiplies the iteration counts) */
 #include <float.h>
@@ -218,8 +219,9 @@ static void check_stream(const cbvh_bvh *b, const cbvh_tri *moved, const cbvh_co
     free(c2.nodes);
 }
 
-/* Naive re-encoding (as printed) may fail or differ from top-down by design;
- * its output and statistics must still not depend on the treelet depth. */
+/* Naive re-encoding (as printed) may differ from top-down by design; it must
+ * still succeed, give a valid CBVH (its repairs: docs/study.md), and not
+ * depend on the treelet depth. */
 static void check_naive(const cbvh_bvh *b, const cbvh_compress_opts *o0) {
     cbvh_compress_opts o = *o0;
     cbvh_tree t[2];
@@ -232,6 +234,12 @@ static void check_naive(const cbvh_bvh *b, const cbvh_compress_opts *o0) {
         o.naive_reencode = 1;
         o.treelet_depth = 1 + 3 * i;
         rc[i] = cbvh_compress_bottomup(&c, NULL, &o, &t[i], &st[i], e[i], sizeof e[i]);
+        if (rc[i])
+            prop_fail("naive N=%d ms=%d enc=%d M=%d: %s", o.params.quant_bits, o.params.min_scale, o.enc,
+                      o.treelet_depth, e[i]);
+        else if (cbvh_tree_check(&t[i], &c, errbuf, sizeof errbuf))
+            prop_fail("naive N=%d ms=%d enc=%d M=%d: tree check: %s", o.params.quant_bits, o.params.min_scale,
+                      o.enc, o.treelet_depth, errbuf);
         free(c.nodes);
     }
     n_cases++;

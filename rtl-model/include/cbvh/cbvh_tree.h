@@ -67,9 +67,12 @@ typedef struct {
     uint64_t backtracks;        /* re-encodes of pairs already in DRAM (depth >= M) */
     uint64_t hist[CBVH_BT_HIST]; /* re-encodes by depth below the processed node
                                     (1 = its child's pair; last bin: deeper) */
-    uint64_t naive_nofit;       /* naive_reencode only: re-encodes where a grown
-                                   upper bound left the node's box, so the codes
-                                   would wrap (then [u, pred(v)] is used) */
+    uint64_t naive_nofit;       /* naive_reencode only: repairs, where a grown
+                                   upper bound left the node's box (the codes
+                                   would wrap) or reached 2^128, and [u, pred(v)]
+                                   clipped to the node's box was used instead, or
+                                   where a pair whose context kept its scale no
+                                   longer decoded alike and was re-encoded */
 } cbvh_bu_stats;
 
 /* Bottom-up streaming compression (Algorithm 1): the float BVH's inner nodes
