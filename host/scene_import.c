@@ -406,7 +406,7 @@ static int ply_parse_header(const char *path, line_reader *r, ply_header *h, cha
             ply_prop *pr = &e->props[e->nprops++];
             char *type = next_token(&p), *name;
             if (type && strcmp(type, "list") == 0) {
-                int count_real;
+                int count_real = 0;
                 pr->is_list = 1;
                 pr->count_size = ply_type_size(next_token(&p), &count_real);
                 pr->item_size = ply_type_size(next_token(&p), &pr->item_is_real);

@@ -116,7 +116,14 @@ static const char *const child_out_names[2][17] = {
      "c1_z_clb", "c1_z_cub"},
 };
 
-static int pair_words(const cbvh_unit_config *cfg) { return (int)cbvh_nodepair_bytes(cfg->params.quant_bits) / 4; }
+/* Words of a node pair: 4 to 6 for N = 3..10 (the configuration is checked
+ * before any unit runs); bounded here so that the 24-byte buffers below are
+ * visibly large enough (GCC -O3 warns otherwise). */
+#define PAIR_WORDS_MAX 6
+static int pair_words(const cbvh_unit_config *cfg) {
+    int n = (int)cbvh_nodepair_bytes(cfg->params.quant_bits) / 4;
+    return n > PAIR_WORDS_MAX ? PAIR_WORDS_MAX : n;
+}
 
 static void node_ctx_layout(cbvh_layout *l) {
     for (int a = 0; a < 3; a++) ctx_layout(l, axis_ctx_names[a]);
@@ -160,7 +167,7 @@ static void encode_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_
         ch[c].empty = (int)((w[6] >> 1) & 1u);
         ch[c].ptr = w[7];
     }
-    uint8_t bytes[24];
+    uint8_t bytes[4 * PAIR_WORDS_MAX];
     cbvh_child_out o[2];
     uint32_t st = cbvh_nodepair_encode(&cfg->params, cfg->enc, &ctx, ch, bytes, o);
     int nw = pair_words(cfg);
@@ -184,7 +191,7 @@ static void decode_pair_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
 }
 static void decode_pair_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
     cbvh_node_ctx ctx = node_ctx_words(in);
-    uint8_t bytes[24];
+    uint8_t bytes[4 * PAIR_WORDS_MAX];
     int nw = pair_words(cfg);
     bytes_from_words(in + 12, nw, bytes);
     cbvh_child_out o[2];
