@@ -2,7 +2,7 @@
  * binary32 (docs/traversal.md §5: the closest hit is the smallest (t, id)
  * over all triangles the unit hits, whatever the tree; any hit iff one exists):
  *   soups  coordinates to +-FLT_MAX; subnormal to tiny normal; mixed 1e+-30;
- *          flat and far (z = 1e5, x, y within 1e-2); a degenerate axis
+ *          flat and far (z = 1e5, x, y within 1e5 +- 5); a degenerate axis
  *          (the cloth's plane); coarse coordinates with shared vertices;
  *   trees  LBVH and binned SAH; top-down and bottom-up CBVHs at N = 3, 6, 10,
  *          both encodings, random min scale (-126, -30, -10, 0) and treelet
@@ -58,7 +58,7 @@ static void soup(cbvh_scene *s, int k) {
                 case HUGE_: x = 2.0f * x * 3.0e38f; break;
                 case TINY: x *= 1e-38f * (float)(1u << (rnd() % 8)); break;
                 case MIXED: x *= (i & 1) ? 1e30f : 1e-30f; break;
-                case FLAT_FAR: x = a == 2 ? 1e5f : 1e5f + 1e-2f * x; break;
+                case FLAT_FAR: x = a == 2 ? 1e5f : 1e5f + 10.0f * x; break;
                 case DEGENERATE_AXIS: x = a == 1 ? 0.25f : x; break;
                 default: x = (float)(rnd() % 3) + (v ? 0.5f * (float)(rnd() % 2) : 0.0f); break;
                 }
