@@ -1681,6 +1681,62 @@ static void reject_combinations_ray_box(gen_t *g) {
             ea[a] = -10, ra[a] = eq[i][0], sa[a] = eq[i][1];
             emit_ray_box(g, inside, dpos, 0, pinf, i < 5 ? 24 : 3, u, ea, ra, sa);
         }
+    /* Generator 8: plane distances of 0 and +-2^-149 against tmin and tmax of
+     * +-0 and +-2^-149.  The comparator orders binary32 by a key in which -0
+     * and +0 are equal; an RTL keying 2^-149 like 0 (and -0 below +0) passed
+     * every vector (a sixth mutation run, docs/gateware.md): no entry or exit
+     * distance was ever 2^-149.  The box [0, 1]^3, the ray along axis a
+     * (the other direction components +0, origin 1/2 there): from
+     * o_a = -2^-149 forward (entry at 2^-149), from +2^-149 backward (exit at
+     * 2^-149), from 0 either way (entry or exit at 0). */
+    static const cbvh_f32 od[][2] = {{CBVH_F32_SIGN | 1u, F_ONE}, {1u, 0xBF800000u}, {0, F_ONE}, {0, 0xBF800000u}};
+    static const cbvh_f32 tmins[] = {0, CBVH_F32_SIGN, 1u, CBVH_F32_SIGN | 1u}, tmaxs[] = {pinf, 0, 1u};
+    for (int a = 0; a < 3; a++)
+        for (size_t i = 0; i < sizeof od / sizeof od[0]; i++)
+            for (size_t j = 0; j < sizeof tmins / sizeof tmins[0]; j++)
+                for (size_t k = 0; k < sizeof tmaxs / sizeof tmaxs[0]; k++) {
+                    cbvh_f32 o[3] = {half, half, half}, d[3] = {0, 0, 0};
+                    o[a] = od[i][0];
+                    d[a] = od[i][1];
+                    emit_ray_box(g, o, d, tmins[j], tmaxs[k], 3, u, e, r, sv);
+                }
+}
+
+/* Generator 8: a barycentric weight just below 1/2 while det' spans more
+ * than 765 bits, with bits in its lowest 32-bit words.  An RTL whose shift
+ * pass starts at word 1 (word 0 never written, words 1 and 2 from the wrong
+ * source words) passed every level-1 and level-2 vector (a sixth mutation
+ * run, docs/gateware.md): the lost bits lower det' by less than one unit in
+ * its top 25 bits, which shows only at a rounding boundary.  v0 = 0,
+ * v1 = (h, -2^-149, 0), v2 = (0, h, -w), d = (-2^-149, 0, -H), o = (x, 0, 0):
+ * with h = 2^112, H = 2^127, w = 2^-149, x = 2^111, det' = 2^351 + 2^-447 and
+ * V' = 2^350, so b1 = RD(V'/det') = pred(1/2), where det' without its
+ * lowest term gives exactly 1/2; the FLT_MAX-sized version (h = H = FLT_MAX,
+ * w = 2^-117, x = FLT_MAX/2) has det' leading at bit 830 and a 2^-415 term.
+ * The axes rotated, the winding swapped (the weight is then b2), the scene
+ * mirrored through the origin. */
+static void tri_low_word_ties(gen_t *g) {
+    /* o_x, h, d_z, v2's last coordinate */
+    static const cbvh_f32 cfg[][4] = {{0x77000000u, 0x77800000u, 0xFF000000u, 0x80000001u},
+                                      {0x7EFFFFFFu, 0x7F7FFFFFu, 0xFF7FFFFFu, 0x85000000u}};
+    for (size_t c = 0; c < 2; c++)
+        for (int rot = 0; rot < 3; rot++)
+            for (int swap = 0; swap < 2; swap++)
+                for (int mirror = 0; mirror < 2; mirror++) {
+                    const cbvh_f32 m = mirror ? CBVH_F32_SIGN : 0;
+                    const cbvh_f32 o0[3] = {cfg[c][0], 0, 0}, d0[3] = {0x80000001u, 0, cfg[c][2]};
+                    const cbvh_f32 a0[3] = {cfg[c][1], 0x80000001u, 0}, b0[3] = {0, cfg[c][1], cfg[c][3]};
+                    const cbvh_f32 *p1 = swap ? b0 : a0, *p2 = swap ? a0 : b0;
+                    cbvh_f32 o[3], d[3], v[9] = {0};
+                    for (int k = 0; k < 3; k++) {
+                        int a = (k + rot) % 3; /* axis k of the frame goes to axis a */
+                        o[a] = o0[k] ? o0[k] ^ m : 0; /* mirrored; a zero stays +0 */
+                        d[a] = d0[k] ? d0[k] ^ m : 0;
+                        v[3 + a] = p1[k] ? p1[k] ^ m : 0;
+                        v[6 + a] = p2[k] ? p2[k] ^ m : 0;
+                    }
+                    emit_ray_tri(g, o, d, v);
+                }
 }
 
 /* Generator 7: quotients that tie exactly while det' and Nt span more than
@@ -1895,6 +1951,7 @@ static void reject_combinations_ray_tri(gen_t *g) {
             }
     tri_wide_ties(g);
     tri_smallest_deciders(g);
+    tri_low_word_ties(g);
 }
 
 /* A binary32 with an exponent in 120..hi and a random significand, of random
