@@ -37,6 +37,10 @@ static int fail(pctx *c, const char *field, const char *fmt, ...) {
         snprintf(c->err, c->errlen, "%s: %s: %s", c->path, field, msg);
     else
         snprintf(c->err, c->errlen, "%s: %s", c->path, msg);
+    /* one line, whatever a key or string in the file holds (a key may
+     * contain "\n": found by fuzz_scene_file) */
+    for (char *p = c->err; *p; p++)
+        if ((unsigned char)*p < 0x20 || *p == 0x7F) *p = '?';
     return -1;
 }
 

@@ -324,8 +324,9 @@ done:
  * declared it invents faces, with more vertex lines it reads a vertex as a
  * face, and it allocates a claimed 4e9 vertices before reading any (then
  * std::bad_alloc).  So the header is parsed here and the body checked
- * against it: ASCII record by record, binary by its minimum size.  Layouts
- * this check does not know go to assimp unchanged. */
+ * against it: ASCII record by record, binary by its minimum size.  The
+ * header must follow the grammar this check knows (ply_parse_header); anything
+ * else is an error, as assimp hangs on some malformed headers. */
 
 enum { PLY_MAX_ELEMENTS = 16, PLY_MAX_PROPS = 64 };
 
@@ -367,58 +368,99 @@ static int ply_type_size(const char *t, int *is_real) {
     return 0;
 }
 
-/* Parse the header from the start of f.  1: parsed into h; 0: a layout this
- * check does not know (assimp decides); -1: provably wrong (message). */
+/* Parse the header from the start of f (whose first four bytes are "ply"
+ * and a line end).  1: parsed into h; -1: anything else, with a one-line
+ * message.  Strict: assimp's PLY reader loops forever on some malformed
+ * headers (a property before any element, a garbled format line), so only
+ * the grammar below reaches it -- ply, format {ascii | binary_little_endian
+ * | binary_big_endian} 1.0, element NAME COUNT, property TYPE NAME,
+ * property list TYPE TYPE NAME, comment, obj_info, end_header. */
 static int ply_parse_header(const char *path, line_reader *r, ply_header *h, char *err, size_t errlen) {
     memset(h, 0, sizeof *h);
     char *p = next_line(r, 0), *t;
-    if (!p || !(t = next_token(&p)) || strcasecmp(t, "ply") != 0 || next_token(&p)) return 0;
+    if (!p || !(t = next_token(&p)) || strcasecmp(t, "ply") != 0 || next_token(&p)) {
+        snprintf(err, errlen, "'%s' line %ld: the PLY magic line is not 'ply'", path, r->lineno);
+        return -1;
+    }
     /* assimp wants the format on the second line */
     p = next_line(r, 0);
-    if (!p || !(t = next_token(&p)) || strcmp(t, "format") != 0 || !(t = next_token(&p))) return 0;
-    if (strcmp(t, "ascii") == 0)
+    char *kind = NULL, *version = NULL, *end;
+    if (p && (t = next_token(&p)) && strcmp(t, "format") == 0) kind = next_token(&p), version = next_token(&p);
+    if (kind && strcmp(kind, "ascii") == 0)
         h->binary = 0;
-    else if (strcmp(t, "binary_little_endian") == 0 || strcmp(t, "binary_big_endian") == 0)
+    else if (kind && (strcmp(kind, "binary_little_endian") == 0 || strcmp(kind, "binary_big_endian") == 0))
         h->binary = 1;
     else
-        return 0;
+        kind = NULL;
+    if (!kind || !version || strtod(version, &end) != 1.0 || *end || next_token(&p)) {
+        snprintf(err, errlen,
+                 "'%s' line %ld: expected the PLY format line 'format ascii|binary_little_endian|binary_big_endian "
+                 "1.0'",
+                 path, r->lineno);
+        return -1;
+    }
     ply_element *e = NULL;
     while ((p = next_line(r, 0))) {
         t = next_token(&p);
         if (strcmp(t, "end_header") == 0) {
             h->body = ftell(r->f);
-            return h->body < 0 ? 0 : 1;
+            if (h->body < 0) {
+                snprintf(err, errlen, "'%s': cannot tell the PLY header's length: %s", path, strerror(errno));
+                return -1;
+            }
+            return 1;
         }
+        if (strcmp(t, "comment") == 0 || strcmp(t, "obj_info") == 0) continue;
         if (strcmp(t, "element") == 0) {
             char *name = next_token(&p), *count = next_token(&p);
-            if (!name || strcmp(name, "TextureFile") == 0 || h->nelem == PLY_MAX_ELEMENTS) return 0;
+            long long n;
+            if (!name || !count || next_token(&p)) {
+                snprintf(err, errlen, "'%s' line %ld: expected 'element NAME COUNT'", path, r->lineno);
+                return -1;
+            }
+            if (h->nelem == PLY_MAX_ELEMENTS || strcmp(name, "TextureFile") == 0) {
+                snprintf(err, errlen, "'%s' line %ld: element '%.32s' not supported (at most %d elements, no TextureFile)",
+                         path, r->lineno, name, PLY_MAX_ELEMENTS);
+                return -1;
+            }
             e = &h->elem[h->nelem++];
             snprintf(e->name, sizeof e->name, "%s", name);
-            long long n;
-            if (!count || !token_is_int(count, &n) || n < 0 || n > 0xFFFFFFFFll) {
+            if (!token_is_int(count, &n) || n < 0 || n > 0xFFFFFFFFll) {
                 snprintf(err, errlen, "'%s' line %ld: element '%.32s' count '%.32s' is not an integer in 0..4294967295",
-                         path, r->lineno, name, count ? count : "");
+                         path, r->lineno, name, count);
                 return -1;
             }
             e->count = (unsigned long long)n;
         } else if (strcmp(t, "property") == 0) {
-            if (!e || e->nprops == PLY_MAX_PROPS) return 0;
+            if (!e || e->nprops == PLY_MAX_PROPS) {
+                snprintf(err, errlen, "'%s' line %ld: %s", path, r->lineno,
+                         e ? "more than 64 properties in one element" : "a property before any element");
+                return -1;
+            }
             ply_prop *pr = &e->props[e->nprops++];
             char *type = next_token(&p), *name;
+            int count_real = 0;
             if (type && strcmp(type, "list") == 0) {
-                int count_real = 0;
                 pr->is_list = 1;
                 pr->count_size = ply_type_size(next_token(&p), &count_real);
                 pr->item_size = ply_type_size(next_token(&p), &pr->item_is_real);
-                if (!pr->count_size || count_real || !pr->item_size) return 0;
-            } else if (!(pr->item_size = ply_type_size(type, &pr->item_is_real))) {
-                return 0;
+            } else {
+                pr->item_size = ply_type_size(type, &pr->item_is_real);
             }
-            if (!(name = next_token(&p))) return 0;
+            name = next_token(&p);
+            if ((pr->is_list && (!pr->count_size || count_real)) || !pr->item_size || !name || next_token(&p)) {
+                snprintf(err, errlen,
+                         "'%s' line %ld: expected 'property TYPE NAME' or 'property list INTTYPE TYPE NAME' with "
+                         "PLY types (char, uchar, short, ushort, int, uint, float, double, int8 .. float64)",
+                         path, r->lineno);
+                return -1;
+            }
             pr->is_face_index = pr->is_list && !pr->item_is_real && strcmp(e->name, "face") == 0 &&
                                 (strcmp(name, "vertex_indices") == 0 || strcmp(name, "vertex_index") == 0);
+        } else {
+            snprintf(err, errlen, "'%s' line %ld: unknown PLY header line '%.32s'", path, r->lineno, t);
+            return -1;
         }
-        /* comment, obj_info and unknown lines: assimp skips them too */
     }
     snprintf(err, errlen, "'%s': the PLY header has no end_header line", path);
     return -1;
@@ -470,24 +512,29 @@ short_record:
     return -1;
 }
 
-/* 0, or -1 with a message.  PLY is told by its magic line, as assimp does
- * for a file whose extension it does not know. */
+/* 0, or -1 with a message.  A PLY file is one named .ply (assimp then reads
+ * it as PLY whatever it holds, and loops forever on some garbage) or one
+ * starting with the magic line, as assimp tells a file whose extension it
+ * does not know. */
 static int ply_check(const char *path, long long file_size, char *err, size_t errlen) {
     FILE *f = fopen(path, "rb");
     if (!f) return 0; /* the importer reports it */
+    const char *dot = strrchr(path, '.');
+    int named = dot && strcasecmp(dot, ".ply") == 0;
     char magic[4] = {0};
     if (fread(magic, 1, 4, f) != 4 || strncasecmp(magic, "ply", 3) != 0 || (magic[3] != '\n' && magic[3] != '\r')) {
         fclose(f);
-        return 0;
+        if (!named) return 0;
+        snprintf(err, errlen, "'%s' line 1: not a PLY file (the first line is not 'ply')", path);
+        return -1;
     }
     rewind(f);
     line_reader r = {f, NULL, 0, 0, 0};
     ply_header *h = malloc(sizeof *h);
     int rc = 0;
     if (!h) goto done;
-    int parsed = ply_parse_header(path, &r, h, err, errlen);
-    if (parsed <= 0) {
-        rc = parsed;
+    if (ply_parse_header(path, &r, h, err, errlen) < 0) {
+        rc = -1;
         goto done;
     }
     unsigned long long nvert = ~0ull; /* no vertex element: nothing to check indices against */

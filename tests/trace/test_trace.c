@@ -554,6 +554,9 @@ static void errors(void **state) {
          "\"effects\": [\"primary\"]}",
          "t.scene: camera.type: unknown camera 'ortho'"},
         {"{\"mesh\": \"" MESH "\", \"effects\": [\"primary\"]}", "t.scene: camera: missing"},
+        /* a key with a line break: the message stays on one line */
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"\\nmaterials\": [], \"effects\": [\"primary\"]}",
+         "t.scene: ?materials: unknown field"},
         {"{\"mesh\": \"" MESH "\",\n " CAMERA ",\n \"effects\": [\"primary\",]}", "t.scene: line 3: not valid JSON"},
         {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\", \"hard_shadows\"]}",
          "t.scene: effects: 'hard_shadows' needs at least one light"},
