@@ -1702,6 +1702,23 @@ static void reject_combinations_ray_box(gen_t *g) {
                 }
 }
 
+/* Emits the ray o0 + t d0 and the triangle (0, p1, p2), given in a frame
+ * (x, y, z), with frame axis k moved to axis (k + rot) % 3 and, when mirror,
+ * every nonzero coordinate negated (a point reflection; a zero stays +0). */
+static void emit_tri_frame(gen_t *g, const cbvh_f32 o0[3], const cbvh_f32 d0[3], const cbvh_f32 p1[3],
+                           const cbvh_f32 p2[3], int rot, int mirror) {
+    const cbvh_f32 m = mirror ? CBVH_F32_SIGN : 0;
+    cbvh_f32 o[3], d[3], v[9] = {0};
+    for (int k = 0; k < 3; k++) {
+        int a = (k + rot) % 3;
+        o[a] = o0[k] ? o0[k] ^ m : 0;
+        d[a] = d0[k] ? d0[k] ^ m : 0;
+        v[3 + a] = p1[k] ? p1[k] ^ m : 0;
+        v[6 + a] = p2[k] ? p2[k] ^ m : 0;
+    }
+    emit_ray_tri(g, o, d, v);
+}
+
 /* Generator 8: a barycentric weight just below 1/2 while det' spans more
  * than 765 bits, with bits in its lowest 32-bit words.  An RTL whose shift
  * pass starts at word 1 (word 0 never written, words 1 and 2 from the wrong
@@ -1723,19 +1740,9 @@ static void tri_low_word_ties(gen_t *g) {
         for (int rot = 0; rot < 3; rot++)
             for (int swap = 0; swap < 2; swap++)
                 for (int mirror = 0; mirror < 2; mirror++) {
-                    const cbvh_f32 m = mirror ? CBVH_F32_SIGN : 0;
                     const cbvh_f32 o0[3] = {cfg[c][0], 0, 0}, d0[3] = {0x80000001u, 0, cfg[c][2]};
                     const cbvh_f32 a0[3] = {cfg[c][1], 0x80000001u, 0}, b0[3] = {0, cfg[c][1], cfg[c][3]};
-                    const cbvh_f32 *p1 = swap ? b0 : a0, *p2 = swap ? a0 : b0;
-                    cbvh_f32 o[3], d[3], v[9] = {0};
-                    for (int k = 0; k < 3; k++) {
-                        int a = (k + rot) % 3; /* axis k of the frame goes to axis a */
-                        o[a] = o0[k] ? o0[k] ^ m : 0; /* mirrored; a zero stays +0 */
-                        d[a] = d0[k] ? d0[k] ^ m : 0;
-                        v[3 + a] = p1[k] ? p1[k] ^ m : 0;
-                        v[6 + a] = p2[k] ? p2[k] ^ m : 0;
-                    }
-                    emit_ray_tri(g, o, d, v);
+                    emit_tri_frame(g, o0, d0, swap ? b0 : a0, swap ? a0 : b0, rot, mirror);
                 }
 }
 
@@ -1757,21 +1764,12 @@ static void tri_wide_ties(gen_t *g) {
                 for (int rot = 0; rot < 3; rot++)
                     for (int swap = 0; swap < 2; swap++)
                         for (int mirror = 0; mirror < 2; mirror++) {
-                            const cbvh_f32 tau = taus[ti], h = hs[hi], m = mirror ? CBVH_F32_SIGN : 0;
+                            const cbvh_f32 tau = taus[ti], h = hs[hi];
                             /* in the unrotated frame (x, y, z); h - 2^23 halves h */
                             const cbvh_f32 d0[3] = {half ? tau * 2 : tau, 0, h};
                             const cbvh_f32 o0[3] = {neg(tau), 0, neg(half ? h - (1u << 23) : h)};
                             const cbvh_f32 a0[3] = {h, tau, 0}, b0[3] = {0, h, tau};
-                            const cbvh_f32 *p1 = swap ? b0 : a0, *p2 = swap ? a0 : b0;
-                            cbvh_f32 o[3], d[3], v[9] = {0};
-                            for (int k = 0; k < 3; k++) {
-                                int a = (k + rot) % 3; /* axis k of the frame goes to axis a */
-                                o[a] = o0[k] ? o0[k] ^ m : 0; /* mirrored; a zero stays +0 */
-                                d[a] = d0[k] ? d0[k] ^ m : 0;
-                                v[3 + a] = p1[k] ? p1[k] ^ m : 0;
-                                v[6 + a] = p2[k] ? p2[k] ^ m : 0;
-                            }
-                            emit_ray_tri(g, o, d, v);
+                            emit_tri_frame(g, o0, d0, swap ? b0 : a0, swap ? a0 : b0, rot, mirror);
                         }
 }
 
