@@ -10,7 +10,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "scene_load.h"
 
@@ -628,34 +631,10 @@ static void note_dropped(const char *message, char *user) {
         if (*c == '\n' || *c == '\r') *c = 0;
 }
 
-int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errlen) {
+/* The import proper: assimp, then our walk over its scene.  Runs in a child
+ * process (import_isolated). */
+static int import_assimp(const char *path, cbvh_scene *out, char *err, size_t errlen) {
     memset(out, 0, sizeof *out);
-    /* Regular files only: a directory would reach assimp (which then reports
-     * "no meshes"), a device reads forever and opening a FIFO blocks. */
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        snprintf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
-        return -1;
-    }
-    if (S_ISDIR(st.st_mode)) {
-        snprintf(err, errlen, "'%s' is a directory, not a mesh file", path);
-        return -1;
-    }
-    if (!S_ISREG(st.st_mode)) {
-        snprintf(err, errlen, "'%s' is not a regular file (a device, FIFO or socket), not a mesh file", path);
-        return -1;
-    }
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
-        return -1;
-    }
-    fclose(f);
-    if (st.st_size <= 0) {
-        snprintf(err, errlen, "'%s' is empty", path);
-        return -1;
-    }
-    if (off_check(path, err, errlen) || ply_check(path, (long long)st.st_size, err, errlen)) return -1;
     dropped_note dropped = {{0}};
     struct aiLogStream log = {note_dropped, (char *)&dropped};
     aiAttachLogStream(&log);
@@ -716,6 +695,170 @@ fail:
     aiReleaseImport(sc);
     if (rc) cbvh_scene_free(out);
     return rc;
+}
+
+/* ---- the import in a child process --------------------------------------
+ * assimp 5.2's readers crash on some malformed files (a NULL dereference in
+ * the glTF reader, found by fuzz_mesh_import), and no check of ours can
+ * stand in front of every reader.  So assimp runs in a forked child that
+ * sends the finished scene (or its one-line error) back through a pipe; a
+ * child that dies first becomes a one-line error here. */
+typedef struct {
+    int32_t rc;
+    uint32_t ntris, nmorph, nkeys;
+    char name[64];
+    char err[512];
+} import_reply;
+
+static int write_full(int fd, const void *buf, size_t n) {
+    const char *p = buf;
+    while (n) {
+        ssize_t k = write(fd, p, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+static int read_full(int fd, void *buf, size_t n) {
+    char *p = buf;
+    while (n) {
+        ssize_t k = read(fd, p, n);
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) return -1;
+        p += k;
+        n -= (size_t)k;
+    }
+    return 0;
+}
+
+static void child_import(const char *path, int fd) {
+    /* a crash is to end the child by its signal, not in a sanitizer's or
+     * fuzzer's handler inherited from the parent */
+    static const int fatal[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+    for (size_t i = 0; i < sizeof fatal / sizeof fatal[0]; i++) signal(fatal[i], SIG_DFL);
+    cbvh_scene s;
+    import_reply r;
+    memset(&r, 0, sizeof r);
+    r.rc = import_assimp(path, &s, r.err, sizeof r.err);
+    if (r.rc == 0) {
+        r.ntris = s.ntris;
+        r.nmorph = s.nmorph;
+        r.nkeys = s.nkeys;
+        memcpy(r.name, s.name, sizeof r.name);
+    }
+    int bad = write_full(fd, &r, sizeof r);
+    if (!bad && r.rc == 0)
+        bad = write_full(fd, s.tris, (size_t)s.ntris * sizeof *s.tris) ||
+              (s.nmorph && write_full(fd, s.morph, (size_t)s.nmorph * s.ntris * sizeof *s.morph)) ||
+              (s.nkeys && (write_full(fd, s.key_time, (size_t)s.nkeys * sizeof *s.key_time) ||
+                           write_full(fd, s.key_weight, (size_t)s.nkeys * s.nmorph * sizeof *s.key_weight)));
+    _exit(bad ? 1 : 0); /* no atexit handlers: they are the parent's */
+}
+
+static int import_isolated(const char *path, cbvh_scene *out, char *err, size_t errlen) {
+    memset(out, 0, sizeof *out);
+    int fds[2];
+    if (pipe(fds)) {
+        snprintf(err, errlen, "cannot import '%s': pipe: %s", path, strerror(errno));
+        return -1;
+    }
+    fflush(NULL); /* nothing buffered is written twice */
+    pid_t pid = fork();
+    if (pid < 0) {
+        snprintf(err, errlen, "cannot import '%s': fork: %s", path, strerror(errno));
+        close(fds[0]);
+        close(fds[1]);
+        return -1;
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        child_import(path, fds[1]);
+    }
+    close(fds[1]);
+    import_reply r;
+    int got = read_full(fds[0], &r, sizeof r) == 0;
+    if (got && r.rc == 0) {
+        if (r.ntris == 0 || r.ntris >= 0x80000000u || r.nmorph > 64 || r.nkeys > (1u << 24)) {
+            got = 0;
+        } else {
+            out->ntris = r.ntris;
+            out->nmorph = r.nmorph;
+            out->nkeys = r.nkeys;
+            memcpy(out->name, r.name, sizeof out->name);
+            out->name[sizeof out->name - 1] = 0;
+            out->tris = malloc((size_t)r.ntris * sizeof *out->tris);
+            if (r.nmorph) out->morph = malloc((size_t)r.nmorph * r.ntris * sizeof *out->morph);
+            if (r.nkeys) {
+                out->key_time = malloc((size_t)r.nkeys * sizeof *out->key_time);
+                out->key_weight = malloc((size_t)r.nkeys * (r.nmorph ? r.nmorph : 1) * sizeof *out->key_weight);
+            }
+            if (!out->tris || (r.nmorph && !out->morph) || (r.nkeys && (!out->key_time || !out->key_weight))) {
+                close(fds[0]);
+                waitpid(pid, NULL, 0);
+                cbvh_scene_free(out);
+                snprintf(err, errlen, "'%s': out of memory for %u triangles", path, r.ntris);
+                return -1;
+            }
+            got = read_full(fds[0], out->tris, (size_t)r.ntris * sizeof *out->tris) == 0 &&
+                  (!r.nmorph || read_full(fds[0], out->morph, (size_t)r.nmorph * r.ntris * sizeof *out->morph) == 0) &&
+                  (!r.nkeys || (read_full(fds[0], out->key_time, (size_t)r.nkeys * sizeof *out->key_time) == 0 &&
+                                read_full(fds[0], out->key_weight,
+                                          (size_t)r.nkeys * r.nmorph * sizeof *out->key_weight) == 0));
+        }
+    }
+    close(fds[0]);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (!got || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        cbvh_scene_free(out);
+        if (WIFSIGNALED(status))
+            snprintf(err, errlen, "cannot import '%s': the importer (assimp) crashed on it (%s)", path,
+                     strsignal(WTERMSIG(status)));
+        else
+            snprintf(err, errlen, "cannot import '%s': the importer (assimp) ended without a result", path);
+        return -1;
+    }
+    if (r.rc) {
+        r.err[sizeof r.err - 1] = 0;
+        snprintf(err, errlen, "%s", r.err);
+        return -1;
+    }
+    return 0;
+}
+
+int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errlen) {
+    memset(out, 0, sizeof *out);
+    /* Regular files only: a directory would reach assimp (which then reports
+     * "no meshes"), a device reads forever and opening a FIFO blocks. */
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        snprintf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+        return -1;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        snprintf(err, errlen, "'%s' is a directory, not a mesh file", path);
+        return -1;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "'%s' is not a regular file (a device, FIFO or socket), not a mesh file", path);
+        return -1;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+        return -1;
+    }
+    fclose(f);
+    if (st.st_size <= 0) {
+        snprintf(err, errlen, "'%s' is empty", path);
+        return -1;
+    }
+    if (off_check(path, err, errlen) || ply_check(path, (long long)st.st_size, err, errlen)) return -1;
+    return import_isolated(path, out, err, errlen);
 }
 
 int cbvh_scene_open(const char *spec, cbvh_scene *out, char *err, size_t errlen) {
