@@ -734,6 +734,20 @@ static int read_full(int fd, void *buf, size_t n) {
     return 0;
 }
 
+/* The arrays a scene's reply is followed by, in order, and their sizes (from
+ * ntris, nmorph and nkeys): one definition for the child and the parent. */
+enum { SCENE_ARRAYS = 4 };
+static void scene_arrays(cbvh_scene *s, void **ptr[SCENE_ARRAYS], size_t len[SCENE_ARRAYS]) {
+    ptr[0] = (void **)&s->tris;
+    len[0] = (size_t)s->ntris * sizeof *s->tris;
+    ptr[1] = (void **)&s->morph;
+    len[1] = (size_t)s->nmorph * s->ntris * sizeof *s->morph;
+    ptr[2] = (void **)&s->key_time;
+    len[2] = (size_t)s->nkeys * sizeof *s->key_time;
+    ptr[3] = (void **)&s->key_weight;
+    len[3] = (size_t)s->nkeys * s->nmorph * sizeof *s->key_weight;
+}
+
 static void child_import(const char *path, int fd) {
     /* a crash is to end the child by its signal, not in a sanitizer's or
      * fuzzer's handler inherited from the parent */
@@ -750,12 +764,33 @@ static void child_import(const char *path, int fd) {
         memcpy(r.name, s.name, sizeof r.name);
     }
     int bad = write_full(fd, &r, sizeof r);
-    if (!bad && r.rc == 0)
-        bad = write_full(fd, s.tris, (size_t)s.ntris * sizeof *s.tris) ||
-              (s.nmorph && write_full(fd, s.morph, (size_t)s.nmorph * s.ntris * sizeof *s.morph)) ||
-              (s.nkeys && (write_full(fd, s.key_time, (size_t)s.nkeys * sizeof *s.key_time) ||
-                           write_full(fd, s.key_weight, (size_t)s.nkeys * s.nmorph * sizeof *s.key_weight)));
+    if (r.rc == 0) {
+        void **ptr[SCENE_ARRAYS];
+        size_t len[SCENE_ARRAYS];
+        scene_arrays(&s, ptr, len);
+        for (int a = 0; a < SCENE_ARRAYS && !bad; a++) bad = len[a] && write_full(fd, *ptr[a], len[a]);
+    }
     _exit(bad ? 1 : 0); /* no atexit handlers: they are the parent's */
+}
+
+/* The scene the child sends after a reply with rc = 0, into out (zeroed).
+ * 0, -1 if it is cut short, -2 out of memory. */
+static int read_scene(int fd, const import_reply *r, cbvh_scene *out) {
+    if (r->ntris == 0 || r->ntris >= 0x80000000u || r->nmorph > 64 || r->nkeys > (1u << 24)) return -1;
+    out->ntris = r->ntris;
+    out->nmorph = r->nmorph;
+    out->nkeys = r->nkeys;
+    memcpy(out->name, r->name, sizeof out->name);
+    out->name[sizeof out->name - 1] = 0;
+    void **ptr[SCENE_ARRAYS];
+    size_t len[SCENE_ARRAYS];
+    scene_arrays(out, ptr, len);
+    for (int a = 0; a < SCENE_ARRAYS; a++) {
+        if (!len[a]) continue;
+        if (!(*ptr[a] = malloc(len[a]))) return -2;
+        if (read_full(fd, *ptr[a], len[a])) return -1;
+    }
+    return 0;
 }
 
 static int import_isolated(const char *path, cbvh_scene *out, char *err, size_t errlen) {
@@ -779,43 +814,20 @@ static int import_isolated(const char *path, cbvh_scene *out, char *err, size_t 
     }
     close(fds[1]);
     import_reply r;
-    int got = read_full(fds[0], &r, sizeof r) == 0;
-    if (got && r.rc == 0) {
-        if (r.ntris == 0 || r.ntris >= 0x80000000u || r.nmorph > 64 || r.nkeys > (1u << 24)) {
-            got = 0;
-        } else {
-            out->ntris = r.ntris;
-            out->nmorph = r.nmorph;
-            out->nkeys = r.nkeys;
-            memcpy(out->name, r.name, sizeof out->name);
-            out->name[sizeof out->name - 1] = 0;
-            out->tris = malloc((size_t)r.ntris * sizeof *out->tris);
-            if (r.nmorph) out->morph = malloc((size_t)r.nmorph * r.ntris * sizeof *out->morph);
-            if (r.nkeys) {
-                out->key_time = malloc((size_t)r.nkeys * sizeof *out->key_time);
-                out->key_weight = malloc((size_t)r.nkeys * (r.nmorph ? r.nmorph : 1) * sizeof *out->key_weight);
-            }
-            if (!out->tris || (r.nmorph && !out->morph) || (r.nkeys && (!out->key_time || !out->key_weight))) {
-                close(fds[0]);
-                waitpid(pid, NULL, 0);
-                cbvh_scene_free(out);
-                snprintf(err, errlen, "'%s': out of memory for %u triangles", path, r.ntris);
-                return -1;
-            }
-            got = read_full(fds[0], out->tris, (size_t)r.ntris * sizeof *out->tris) == 0 &&
-                  (!r.nmorph || read_full(fds[0], out->morph, (size_t)r.nmorph * r.ntris * sizeof *out->morph) == 0) &&
-                  (!r.nkeys || (read_full(fds[0], out->key_time, (size_t)r.nkeys * sizeof *out->key_time) == 0 &&
-                                read_full(fds[0], out->key_weight,
-                                          (size_t)r.nkeys * r.nmorph * sizeof *out->key_weight) == 0));
-        }
-    }
-    close(fds[0]);
+    int got = read_full(fds[0], &r, sizeof r) == 0 ? 0 : -1;
+    if (got == 0 && r.rc == 0) got = read_scene(fds[0], &r, out);
+    close(fds[0]); /* a child still writing gets EPIPE and ends */
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    if (!got || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    if (got == -2) {
         cbvh_scene_free(out);
-        if (WIFSIGNALED(status))
+        snprintf(err, errlen, "'%s': out of memory for %u triangles", path, r.ntris);
+        return -1;
+    }
+    if (got || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        cbvh_scene_free(out);
+        if (WIFSIGNALED(status) && WTERMSIG(status) != SIGPIPE)
             snprintf(err, errlen, "cannot import '%s': the importer (assimp) crashed on it (%s)", path,
                      strsignal(WTERMSIG(status)));
         else
