@@ -88,7 +88,8 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
             cull_d = cbvh_rbf_f32(cull);
             continue;
         }
-        if (e->ptr >= t->npairs) return -1;
+        /* a tree visits each pair at most once per ray: more is a pointer cycle */
+        if (e->ptr >= t->npairs || ts.s.nodes >= t->npairs) return -1;
         ts.s.nodes++;
         trav_fetch(&ts, (uint64_t)e->ptr * t->pair_bytes, t->pair_bytes);
         const uint8_t *pair = t->pairs + (size_t)e->ptr * t->pair_bytes;

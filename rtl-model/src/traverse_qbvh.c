@@ -75,6 +75,10 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
         int go = 0; /* a child to descend into */
         if (!(cnt & CBVH_QBVH_LEAF)) {
             uint32_t f = q->first[node];
+            if (qs.s.nodes >= q->nnodes) { /* each node is visited at most once: a cycle */
+                rc = -1;
+                goto finish;
+            }
             qs.s.nodes++;
             trav_fetch(&qs, bmin_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
             trav_fetch(&qs, bmax_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);

@@ -236,9 +236,63 @@ static void layout_cases(void) {
     }
 }
 
+/* A CBVH whose pair 0 has an inner child pointing back to pair 0 with the
+ * pair's own box (relative codes 0 and 2^N: the child's context is the
+ * pair's), so every visit hits it again: -1 after npairs visits, not a hang
+ * (docs/traversal.md §5, a malformed tree).  Both decoders: the fast path and
+ * the unit (the fast path takes only pairs of the codec's width: padded). */
+static void cyclic_cbvh(void) {
+    for (int unit = 0; unit < 2; unit++) {
+        cbvh_tree t;
+        memset(&t, 0, sizeof t);
+        t.params.quant_bits = 6;
+        t.params.min_scale = -30;
+        t.enc = CBVH_ENC_RELATIVE;
+        for (int a = 0; a < 3; a++) {
+            t.root_lo[a] = fb(0);
+            t.root_hi[a] = fb(1);
+            if (cbvh_axis_root_ctx(&t.params, t.root_lo[a], t.root_hi[a], &t.root_ctx.axis[a])) {
+                fprintf(stderr, "FAIL cyclic CBVH: root context\n");
+                failures++;
+                return;
+            }
+        }
+        uint8_t pair[32] = {0};
+        cbvh_child_in in[2];
+        cbvh_child_out out[2];
+        memset(in, 0, sizeof in);
+        for (int a = 0; a < 3; a++) {
+            in[0].lo[a] = t.root_lo[a];
+            in[0].hi[a] = t.root_hi[a];
+        }
+        in[0].ptr = 0; /* itself */
+        in[1].empty = 1;
+        in[1].leaf = 1;
+        if (cbvh_nodepair_encode(&t.params, t.enc, &t.root_ctx, in, pair, out)) {
+            fprintf(stderr, "FAIL cyclic CBVH: encode\n");
+            failures++;
+            return;
+        }
+        t.pair_bytes = unit ? sizeof pair : cbvh_nodepair_bytes(6);
+        t.npairs = 1;
+        t.pairs = pair;
+        cbvh_tri tri = {{{fb(0), fb(0), fb(0)}, {fb(1), fb(0), fb(0)}, {fb(0), fb(1), fb(0)}}};
+        cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(2)}, {0, 0, fb(-1)}, 0, CBVH_F32_POS_INF};
+        cbvh_trav_hit h;
+        cbvh_trav_stats st = {0};
+        int rc = cbvh_trace_cbvh(&t, &tri, &r, 24, CBVH_TRAV_CLOSEST, &h, &st);
+        if (rc != -1 || h.hit) {
+            fprintf(stderr, "FAIL cyclic CBVH (%s decode): rc %d hit %d, want -1 and no hit\n",
+                    unit ? "unit" : "fast", rc, h.hit);
+            failures++;
+        }
+    }
+}
+
 int main(void) {
     bad_rays();
     layout_cases();
+    cyclic_cbvh();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
     run_scene("proc:far:8");
     run_scene("proc:cloth:24");
