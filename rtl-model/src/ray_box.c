@@ -325,7 +325,9 @@ uint32_t cbvh_ray_box_prep(const cbvh_rb_ray *p, cbvh_f32 tmax, int M, const cbv
         memset(out, 0, sizeof *out);
         return st;
     }
+#ifndef CBVH_NO_FAST_PATHS /* a test build: ray_box_f64.h */
     if (fast_grid(p, tmax, M, axis, out) == 0) return 0;
+#endif
     cbvh_ray r = *p->ray;
     r.tmax = tmax;
     return cbvh_ray_box_exact_only(&r, M, axis, out);
@@ -338,7 +340,9 @@ uint32_t cbvh_ray_box_float_prep(const cbvh_rb_ray *p, cbvh_f32 tmax, int M, con
         memset(out, 0, sizeof *out);
         return st;
     }
+#ifndef CBVH_NO_FAST_PATHS
     if (fast_float(p, tmax, M, lo, hi, out) == 0) return 0;
+#endif
     cbvh_ray r = *p->ray;
     r.tmax = tmax;
     return cbvh_ray_box_float_exact_only(&r, M, lo, hi, out);

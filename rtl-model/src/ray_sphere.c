@@ -258,7 +258,11 @@ uint32_t cbvh_ray_sphere(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r, i
     *hit = 0;
     uint32_t st = check(ray, c, r);
     if (st || empty_segment(ray)) return st;
+#ifndef CBVH_NO_FAST_PATHS /* a test build: ray_box_f64.h */
     int f = fast_decide(ray, c, r);
+#else
+    int f = -1;
+#endif
     *hit = f >= 0 ? f : exact_decide(ray, c, r);
     return 0;
 }

@@ -1,5 +1,5 @@
-# cmake -DA=file -DB=file -P compare_digests.cmake: fail unless both digest
-# files exist and are identical.
+# cmake -DA=file -DB=file [-DWHAT=label] -P compare_digests.cmake: fail unless
+# both digest files exist and are identical.
 foreach(f ${A} ${B})
     if(NOT EXISTS ${f})
         message(FATAL_ERROR "digest file missing: ${f}")
@@ -10,6 +10,9 @@ file(READ ${B} db)
 string(STRIP "${da}" da)
 string(STRIP "${db}" db)
 if(NOT da STREQUAL db)
-    message(FATAL_ERROR "determinism broken: -O0 digest ${da} != -O2 digest ${db}")
+    if(NOT WHAT)
+        set(WHAT "determinism broken: -O0 vs -O2")
+    endif()
+    message(FATAL_ERROR "${WHAT}: digest ${da} != ${db}")
 endif()
 message(STATUS "digests agree: ${da}")

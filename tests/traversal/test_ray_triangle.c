@@ -327,12 +327,35 @@ static void named(void) {
     expect("zero direction", &n, tri, 0, 0, CBVH_ST_ZERO_DIR);
     const float inf_tri[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     cbvh_ray ok = {{fb(0.25f), fb(0.25f), fb(2.0f)}, {0, 0, fb(-1.0f)}, 0, CBVH_F32_POS_INF};
-    cbvh_f32 v[3][3];
-    for (int k = 0; k < 3; k++)
-        for (int a = 0; a < 3; a++) v[k][a] = fb(inf_tri[k][a]);
-    v[2][1] = CBVH_F32_POS_INF;
-    cbvh_tri_result res;
-    if (cbvh_ray_triangle(&ok, v[0], v[1], v[2], &res) != CBVH_ST_NAN_INF || res.hit) failures++;
+    /* a NaN or an infinity in any of the nine coordinates is rejected (the
+     * unit's binary64 filter must not decide such a triangle), for rays that
+     * hit the finite triangle, along an axis and oblique, each axis the
+     * largest |d| (the filter's sheared axis) */
+    const cbvh_f32 bad[3] = {0x7FC00000u, CBVH_F32_POS_INF, CBVH_F32_NEG_INF};
+    for (int ri = 0; ri < 3 * 64; ri++) {
+        int axis = ri % 3; /* toward (0.2, 0.3) on the triangle: along the axis, then oblique */
+        float ox = ri < 3 ? 0.2f : (float)(ri % 7) - 3.0f, oy = ri < 3 ? 0.3f : (float)(ri % 5) * 0.75f - 1.5f;
+        const float o3[3] = {ox, oy, 2.0f}, d3[3] = {0.2f - ox, 0.3f - oy, -2.0f};
+        cbvh_ray ar = ok;
+        for (int a = 0; a < 3; a++) {
+            ar.o[a] = fb(o3[(a + 2 - axis) % 3]);
+            ar.d[a] = fb(d3[(a + 2 - axis) % 3]);
+        }
+        for (int pos = 0; pos < 9; pos++)
+            for (int b = 0; b < 3; b++) {
+                cbvh_f32 w[3][3];
+                cbvh_tri_result res;
+                for (int k = 0; k < 3; k++)
+                    for (int a = 0; a < 3; a++) w[k][a] = fb(inf_tri[k][(a + 2 - axis) % 3]);
+                w[pos / 3][pos % 3] = bad[b];
+                uint32_t st = cbvh_ray_triangle(&ar, w[0], w[1], w[2], &res);
+                if (st != CBVH_ST_NAN_INF || res.hit) {
+                    fprintf(stderr, "FAIL vertex %d coordinate %d = %08X, ray along %d: status %X, want NAN_INF\n",
+                            pos / 3, pos % 3, bad[b], axis, st);
+                    failures++;
+                }
+            }
+    }
     /* far from the origin: t = 2^20 exactly */
     cbvh_ray far = {{fb(1e6f), fb(-2e6f), fb(1048576.0f)}, {0, 0, fb(-1.0f)}, 0, CBVH_F32_POS_INF};
     const float ft[3][3] = {{999999.0f, -2000001.0f, 0}, {1000002.0f, -2000001.0f, 0}, {1000000.0f, -1999998.0f, 0}};
