@@ -193,7 +193,7 @@ static void bad_rays(void) {
  * unit traversal; what is not a tree is refused with a reason. */
 static void layout_cases(void) {
     {
-        cbvh_tri tri = {{{fb(0), fb(0), fb(0)}, {fb(1), fb(0), fb(0)}, {fb(0), fb(1), fb(0)}}};
+        cbvh_tri tri = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}; /* floats, not bit patterns */
         cbvh_bvh_node leaf = {{0, 0, 0}, {1, 1, 0}, {0, 0}, 0, 1};
         uint32_t prim = 0;
         cbvh_bvh b1 = {&leaf, 1, 0, &prim, 1};
@@ -236,47 +236,50 @@ static void layout_cases(void) {
     }
 }
 
+/* A one-pair CBVH over [0, 1]^3 (N = 6, relative codes): child 0 with the
+ * pair's own box, an inner node at pair `ptr` or a leaf whose IDs start at
+ * `ptr`; child 1 empty.  pair_bytes 16, or padded to 32 (the fast decode takes
+ * only pairs of the codec's width: the unit then decodes).  0 on success. */
+static int one_pair_cbvh(cbvh_tree *t, uint8_t pair[32], int leaf, uint32_t ptr, int padded) {
+    memset(t, 0, sizeof *t);
+    memset(pair, 0, 32);
+    t->params.quant_bits = 6;
+    t->params.min_scale = -30;
+    t->enc = CBVH_ENC_RELATIVE;
+    cbvh_child_in in[2];
+    cbvh_child_out out[2];
+    memset(in, 0, sizeof in);
+    for (int a = 0; a < 3; a++) {
+        t->root_lo[a] = in[0].lo[a] = fb(0);
+        t->root_hi[a] = in[0].hi[a] = fb(1);
+        if (cbvh_axis_root_ctx(&t->params, t->root_lo[a], t->root_hi[a], &t->root_ctx.axis[a])) return -1;
+    }
+    in[0].leaf = leaf;
+    in[0].ptr = ptr;
+    in[1].empty = 1;
+    in[1].leaf = 1;
+    if (cbvh_nodepair_encode(&t->params, t->enc, &t->root_ctx, in, pair, out)) return -1;
+    t->pair_bytes = padded ? 32 : cbvh_nodepair_bytes(6);
+    t->npairs = 1;
+    t->pairs = pair;
+    return 0;
+}
+
 /* A CBVH whose pair 0 has an inner child pointing back to pair 0 with the
  * pair's own box (relative codes 0 and 2^N: the child's context is the
  * pair's), so every visit hits it again: -1 after npairs visits, not a hang
  * (docs/traversal.md §5, a malformed tree).  Both decoders: the fast path and
- * the unit (the fast path takes only pairs of the codec's width: padded). */
+ * the unit. */
 static void cyclic_cbvh(void) {
     for (int unit = 0; unit < 2; unit++) {
         cbvh_tree t;
-        memset(&t, 0, sizeof t);
-        t.params.quant_bits = 6;
-        t.params.min_scale = -30;
-        t.enc = CBVH_ENC_RELATIVE;
-        for (int a = 0; a < 3; a++) {
-            t.root_lo[a] = fb(0);
-            t.root_hi[a] = fb(1);
-            if (cbvh_axis_root_ctx(&t.params, t.root_lo[a], t.root_hi[a], &t.root_ctx.axis[a])) {
-                fprintf(stderr, "FAIL cyclic CBVH: root context\n");
-                failures++;
-                return;
-            }
-        }
-        uint8_t pair[32] = {0};
-        cbvh_child_in in[2];
-        cbvh_child_out out[2];
-        memset(in, 0, sizeof in);
-        for (int a = 0; a < 3; a++) {
-            in[0].lo[a] = t.root_lo[a];
-            in[0].hi[a] = t.root_hi[a];
-        }
-        in[0].ptr = 0; /* itself */
-        in[1].empty = 1;
-        in[1].leaf = 1;
-        if (cbvh_nodepair_encode(&t.params, t.enc, &t.root_ctx, in, pair, out)) {
-            fprintf(stderr, "FAIL cyclic CBVH: encode\n");
+        uint8_t pair[32];
+        if (one_pair_cbvh(&t, pair, 0, 0, unit)) {
+            fprintf(stderr, "FAIL cyclic CBVH: cannot encode\n");
             failures++;
             return;
         }
-        t.pair_bytes = unit ? sizeof pair : cbvh_nodepair_bytes(6);
-        t.npairs = 1;
-        t.pairs = pair;
-        cbvh_tri tri = {{{fb(0), fb(0), fb(0)}, {fb(1), fb(0), fb(0)}, {fb(0), fb(1), fb(0)}}};
+        cbvh_tri tri = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}; /* floats, not bit patterns */
         cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(2)}, {0, 0, fb(-1)}, 0, CBVH_F32_POS_INF};
         cbvh_trav_hit h;
         cbvh_trav_stats st = {0};
@@ -289,10 +292,58 @@ static void cyclic_cbvh(void) {
     }
 }
 
+/* The byte counters follow the memory image of docs/traversal.md §5 (node
+ * pairs from 0, then the 4-byte IDs, then the 36-byte triangles, each region
+ * on a 64-byte line; every read counts the lines it covers): a one-pair CBVH
+ * whose leaf's single ID sits at every index 0..63 of the ID array and names
+ * triangle 0..15, so that every ID offset within a line and both triangle
+ * alignments occur.  Expected lines, spelled out from the map: the pair (one
+ * line), the ID (4 bytes at a multiple of 4: one line), the triangle. */
+static void memory_map(void) {
+    cbvh_tri tris[16];
+    for (int i = 0; i < 16; i++) {
+        const float v[3][3] = {{0, 0, 0.5f}, {1, 0, 0.5f}, {0, 1, 0.5f}};
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++) tris[i].v[k][a] = v[k][a];
+    }
+    uint32_t ids[64];
+    long bad = 0;
+    for (uint32_t p = 0; p < 64; p++)
+        for (uint32_t id = 0; id < 16; id++)
+            for (int unit = 0; unit < 2; unit++) {
+                cbvh_tree t;
+                uint8_t pair[32];
+                if (one_pair_cbvh(&t, pair, 1, p, unit)) {
+                    bad++;
+                    continue;
+                }
+                for (uint32_t i = 0; i < 64; i++) ids[i] = i == p ? id | CBVH_ID_LAST : CBVH_ID_LAST;
+                t.ids = ids;
+                t.nids = p + 1;
+                uint64_t ids_base = (t.npairs * t.pair_bytes + 63) / 64 * 64;
+                uint64_t tris_base = (ids_base + 4u * t.nids + 63) / 64 * 64, ta = tris_base + 36u * id;
+                uint64_t want = 1 + 1 + ((ta + 35) / 64 - ta / 64 + 1);
+                cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(2)}, {0, 0, fb(-1)}, 0, CBVH_F32_POS_INF};
+                cbvh_trav_hit h;
+                cbvh_trav_stats st = {0};
+                int rc = cbvh_trace_cbvh(&t, tris, &r, 24, CBVH_TRAV_CLOSEST, &h, &st);
+                if (rc || !h.hit || h.prim != id || st.nodes != 1 || st.tri_tests != 1 || st.lines != want ||
+                    st.bytes != 64 * want) {
+                    if (bad++ < 5)
+                        fprintf(stderr, "FAIL memory map: ID index %u, triangle %u (%s decode): rc %d hit %d prim %u, "
+                                        "%llu lines / %llu bytes, want %llu\n",
+                                p, id, unit ? "unit" : "fast", rc, h.hit, h.prim, (unsigned long long)st.lines,
+                                (unsigned long long)st.bytes, (unsigned long long)want);
+                }
+            }
+    failures += bad;
+}
+
 int main(void) {
     bad_rays();
     layout_cases();
     cyclic_cbvh();
+    memory_map();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
     run_scene("proc:far:8");
     run_scene("proc:cloth:24");
