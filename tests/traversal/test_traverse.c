@@ -7,7 +7,8 @@
  *     M = 24 and M = 8;
  *   - both == brute force over all triangles (a subset of rays);
  *   - any-hit finds a hit iff closest-hit does, and the hit it reports is a
- *     real hit of the unit in [tmin, tmax];
+ *     real hit of the unit in [tmin, tmax]; its counters are a prefix of
+ *     closest-hit's (it stops at its first accepted hit);
  *   - CBVH box tests >= float-BVH box tests (sums), counters plausible;
  * scenes: scenes/bunny-small.obj, proc:far (far from the origin), proc:cloth
  * (a plane hit edge-on and at grazing angles). */
@@ -30,6 +31,23 @@
 
 static long failures;
 static uint64_t rs = 0xD1B54A32D192ED03u;
+
+static void add_stats(cbvh_trav_stats *sum, const cbvh_trav_stats *s) {
+    sum->nodes += s->nodes;
+    sum->box_tests += s->box_tests;
+    sum->tri_tests += s->tri_tests;
+    sum->lines += s->lines;
+    sum->bytes += s->bytes;
+    if (s->max_stack > sum->max_stack) sum->max_stack = s->max_stack;
+}
+
+/* Any hit walks as closest hit does until the first accepted hit (nothing
+ * is culled before a hit) and stops there: its work is a prefix of the
+ * closest-hit traversal's (and, over many rays, strictly less). */
+static int any_is_prefix(const cbvh_trav_stats *any, const cbvh_trav_stats *closest) {
+    return any->nodes <= closest->nodes && any->box_tests <= closest->box_tests &&
+           any->tri_tests <= closest->tri_tests && any->lines <= closest->lines;
+}
 
 static void run_scene(const char *spec) {
     cbvh_scene s;
@@ -62,13 +80,16 @@ static void run_scene(const char *spec) {
     for (int i = 0; i < RAYS; i++) {
         rays[i] = box_ray(&rs, lo, hi, i, edge_on);
         cbvh_trav_hit any;
-        if (cbvh_trace_bvh(&b, s.tris, &rays[i], 24, CBVH_TRAV_CLOSEST, &ref[i], &fs) ||
-            cbvh_trace_bvh(&b, s.tris, &rays[i], 24, CBVH_TRAV_ANY, &any, &fa)) {
+        cbvh_trav_stats c1 = {0}, a1 = {0};
+        if (cbvh_trace_bvh(&b, s.tris, &rays[i], 24, CBVH_TRAV_CLOSEST, &ref[i], &c1) ||
+            cbvh_trace_bvh(&b, s.tris, &rays[i], 24, CBVH_TRAV_ANY, &any, &a1)) {
             failures++;
             continue;
         }
+        add_stats(&fs, &c1);
+        add_stats(&fa, &a1);
         hits += ref[i].hit;
-        if (any.hit != ref[i].hit) failures++;
+        if (any.hit != ref[i].hit || !any_is_prefix(&a1, &c1)) failures++;
         cbvh_trav_hit ph, pa;
         if (!fb.nodes || cbvh_trace_bvh_float(&fb, s.tris, &rays[i], CBVH_TRAV_CLOSEST, &ph, &ps) ||
             cbvh_trace_bvh_float(&fb, s.tris, &rays[i], CBVH_TRAV_ANY, &pa, &pas) || !same_hit(&ph, &ref[i]) ||
@@ -99,7 +120,7 @@ static void run_scene(const char *spec) {
         failures++;
     }
     if (fb.nodes) cbvh_fbvh_free(&fb);
-    if (hits < RAYS / 10 || fs.box_tests < (uint64_t)RAYS) failures++;
+    if (hits < RAYS / 10 || fs.box_tests < (uint64_t)RAYS || !(fa.tri_tests < fs.tri_tests)) failures++;
     struct {
         int N, M;
         cbvh_encoding enc;
@@ -117,11 +138,15 @@ static void run_scene(const char *spec) {
         long mismatches = 0;
         for (int i = 0; i < RAYS; i++) {
             cbvh_trav_hit h, any;
-            if (cbvh_trace_cbvh(&t, s.tris, &rays[i], cfg[c].M, CBVH_TRAV_CLOSEST, &h, &cs) ||
-                cbvh_trace_cbvh(&t, s.tris, &rays[i], cfg[c].M, CBVH_TRAV_ANY, &any, &ca)) {
+            cbvh_trav_stats c1 = {0}, a1 = {0};
+            if (cbvh_trace_cbvh(&t, s.tris, &rays[i], cfg[c].M, CBVH_TRAV_CLOSEST, &h, &c1) ||
+                cbvh_trace_cbvh(&t, s.tris, &rays[i], cfg[c].M, CBVH_TRAV_ANY, &any, &a1)) {
                 failures++;
                 continue;
             }
+            add_stats(&cs, &c1);
+            add_stats(&ca, &a1);
+            if (!any_is_prefix(&a1, &c1)) mismatches++;
             if (!same_hit(&h, &ref[i])) {
                 if (mismatches++ < 3)
                     fprintf(stderr, "FAIL %s N=%d M=%d ray %d: CBVH hit %d prim %u t %08X, float %d prim %u t %08X\n",
@@ -141,7 +166,7 @@ static void run_scene(const char *spec) {
                     (unsigned long long)cs.box_tests, (unsigned long long)fs.box_tests);
             failures++;
         }
-        if (cs.bytes != cs.lines * CBVH_LINE_BYTES || cs.nodes == 0) failures++;
+        if (cs.bytes != cs.lines * CBVH_LINE_BYTES || cs.nodes == 0 || !(ca.tri_tests < cs.tri_tests)) failures++;
         cbvh_tree_free(&t);
     }
     free(rays);
