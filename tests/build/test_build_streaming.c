@@ -18,6 +18,7 @@
 #include "cbvh/cbvh_tree.h"
 #include "test_util.h"
 #include "scene_load.h"
+#include "../../rtl-model/src/cbvh_layout.h"
 
 #ifndef CBVH_SCENES_DIR
 #error "CBVH_SCENES_DIR must name the scenes folder"
@@ -201,6 +202,28 @@ static void test_random_soups(void **st) {
     assert_true(n_ok - ok_before > 1050ul * 12 * 9 / 10); /* mostly builds, not just errors */
 }
 
+/* A tree whose pairs or IDs do not fit the node's pointer field (or the ID
+ * array's 31 bits) is refused before anything is allocated: checked on the
+ * counts alone, as a scene this large cannot be built in a test. */
+static void test_pointer_limits(void **st) {
+    (void)st;
+    static const struct {
+        int n;
+        uint32_t npairs, nids;
+    } c[] = {{6, 1u << 27, 1}, {6, 1, (1u << 27) - 1u}, {3, 1, 0x80000000u}, {10, 1, 0x80000000u}};
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        cbvh_compress_opts o = opts(c[i].n, CBVH_MIN_SCALE_DEFAULT, CBVH_ENC_MODULO, 1, 0);
+        cbvh_layout l = {NULL, NULL, c[i].npairs, c[i].nids};
+        cbvh_bvh b;
+        memset(&b, 0, sizeof b);
+        cbvh_tree t;
+        char why[256] = "";
+        assert_int_equal(cbvh_tree_init(&t, &b, &o, &l, 0, why, sizeof why), -1);
+        assert_non_null(strstr(why, "do not fit"));
+        assert_null(t.pairs);
+    }
+}
+
 static void test_errors(void **st) {
     (void)st;
     cbvh_compress_opts o = opts(6, CBVH_MIN_SCALE_DEFAULT, CBVH_ENC_MODULO, 4, 0);
@@ -283,7 +306,7 @@ static void test_compare_detects(void **st) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_compare_detects), cmocka_unit_test(test_bunny),  cmocka_unit_test(test_procedural),
-        cmocka_unit_test(test_random_soups),    cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_random_soups),    cmocka_unit_test(test_errors), cmocka_unit_test(test_pointer_limits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
