@@ -924,6 +924,74 @@ static void test_modulo_fewer_backtracks(void **st) {
     cbvh_scene_free(&s);
 }
 
+/* A backtrack 70 levels deep (the histogram's last bin): a chain of inner
+ * nodes j = 0..69, each the parent of a leaf spanning [-29.5, 33.5] 2^s in x
+ * (s = -j) and of node j + 1.  With N = 6 each box fits 64 cells of its own
+ * scale s, also when quantized on its parent's grid s + 1 ([-30, 34]), but
+ * not on any coarser one ([-32, 36] on s + 2): so when a node's scale grows,
+ * its child's grows too.  A top node with a leaf spanning [0, 2^20],
+ * processed last, coarsens node 0's grid, and the change runs down the
+ * whole chain. */
+static void test_backtrack_deep_chain(void **st) {
+    (void)st;
+    enum { D = 70, N = 6 };
+    cbvh_scene s;
+    memset(&s, 0, sizeof s);
+    s.ntris = D + 2;
+    s.tris = calloc(s.ntris, sizeof *s.tris);
+    assert_non_null(s.tris);
+    for (uint32_t j = 0; j <= D + 1; j++) {
+        int sc = -(int)j;
+        s.tris[j].v[0][0] = s.tris[j].v[2][0] = j <= D ? ldexpf(-29.5f, sc) : 0.0f;
+        s.tris[j].v[1][0] = j <= D ? ldexpf(33.5f, sc) : 0x1p20f;
+        s.tris[j].v[2][1] = 0x1p-100f;
+    }
+    /* nodes: 0 the top, 1 + j inner j, 1 + D the big leaf, 2 + D + j leaf j */
+    cbvh_bvh b;
+    memset(&b, 0, sizeof b);
+    b.nnodes = 2 * D + 3;
+    b.nodes = calloc(b.nnodes, sizeof *b.nodes);
+    b.nprims = D + 2;
+    b.prims = calloc(b.nprims, sizeof *b.prims);
+    assert_non_null(b.nodes);
+    assert_non_null(b.prims);
+    for (uint32_t j = 0; j <= D + 1; j++) {
+        cbvh_bvh_node *lf = &b.nodes[j <= D ? 2 + D + j : 1 + D];
+        lf->first = j;
+        lf->count = 1;
+        b.prims[j] = j;
+        cbvh_tri_bounds(&s.tris[j], lf->lo, lf->hi);
+    }
+    for (int j = D - 1; j >= -1; j--) { /* inner j (j = -1: the top), bottom-up */
+        cbvh_bvh_node *n = &b.nodes[1 + j];
+        n->child[0] = j >= 0 ? 2 + D + (uint32_t)j : 1 + D;
+        n->child[1] = j + 1 < D ? 2 + (uint32_t)j : 2 + D + D;
+        for (int a = 0; a < 3; a++) {
+            const cbvh_bvh_node *l = &b.nodes[n->child[0]], *r = &b.nodes[n->child[1]];
+            n->lo[a] = fminf(l->lo[a], r->lo[a]);
+            n->hi[a] = fmaxf(l->hi[a], r->hi[a]);
+        }
+    }
+    no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+    cbvh_compress_opts o = opts(N, -126, CBVH_ENC_MODULO, 1);
+    cbvh_tree td, bu;
+    cbvh_bu_stats bs;
+    no_error(cbvh_compress_topdown(&b, &o, &td, errbuf, sizeof errbuf));
+    no_error(cbvh_compress_bottomup(&b, NULL, &o, &bu, &bs, errbuf, sizeof errbuf));
+    no_error(cbvh_tree_check(&bu, &b, errbuf, sizeof errbuf));
+    assert_int_equal(bu.npairs, td.npairs);
+    assert_memory_equal(bu.pairs, td.pairs, (size_t)td.npairs * td.pair_bytes);
+    assert_true(bs.hist[CBVH_BT_HIST - 1] >= D - CBVH_BT_HIST + 1); /* depths 64..70 */
+    uint64_t sum = 0;
+    for (int i = 0; i < CBVH_BT_HIST; i++) sum += bs.hist[i];
+    assert_int_equal(sum, bs.reencodes);
+    assert_int_equal(bs.naive_nofit, 0);
+    cbvh_tree_free(&td);
+    cbvh_tree_free(&bu);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
 /* ---- refit ------------------------------------------------------------- */
 
 static void test_refit(void **st) {
@@ -992,6 +1060,7 @@ int main(void) {
         cmocka_unit_test(test_naive_backtrack_differs),
         cmocka_unit_test(test_naive_extremes_valid),
         cmocka_unit_test(test_modulo_fewer_backtracks),
+        cmocka_unit_test(test_backtrack_deep_chain),
         cmocka_unit_test(test_refit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
