@@ -9,6 +9,7 @@
 
 #include "cbvh/traversal_units.h"
 #include "exact_wide.h"
+#include "fast_paths.h"
 #include "grid.h"
 #include "ray_prep.h"
 
@@ -325,9 +326,7 @@ uint32_t cbvh_ray_box_prep(const cbvh_rb_ray *p, cbvh_f32 tmax, int M, const cbv
         memset(out, 0, sizeof *out);
         return st;
     }
-#ifndef CBVH_NO_FAST_PATHS /* a test build: ray_box_f64.h */
-    if (fast_grid(p, tmax, M, axis, out) == 0) return 0;
-#endif
+    if (CBVH_FAST_PATHS && fast_grid(p, tmax, M, axis, out) == 0) return 0;
     cbvh_ray r = *p->ray;
     r.tmax = tmax;
     return cbvh_ray_box_exact_only(&r, M, axis, out);
@@ -340,9 +339,7 @@ uint32_t cbvh_ray_box_float_prep(const cbvh_rb_ray *p, cbvh_f32 tmax, int M, con
         memset(out, 0, sizeof *out);
         return st;
     }
-#ifndef CBVH_NO_FAST_PATHS
-    if (fast_float(p, tmax, M, lo, hi, out) == 0) return 0;
-#endif
+    if (CBVH_FAST_PATHS && fast_float(p, tmax, M, lo, hi, out) == 0) return 0;
     cbvh_ray r = *p->ray;
     r.tmax = tmax;
     return cbvh_ray_box_float_exact_only(&r, M, lo, hi, out);

@@ -35,10 +35,9 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
+#include "fast_paths.h"
 
-/* CBVH_NO_FAST_PATHS (a test build, tests/traversal/test_fast_invisible.c):
- * every traversal fast path off, the units' exact paths decide everything. */
-#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0 && !defined(CBVH_NO_FAST_PATHS)
+#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0 && CBVH_FAST_PATHS
 #define CBVH_RBF_ENABLED 1
 #else
 #define CBVH_RBF_ENABLED 0

@@ -21,6 +21,7 @@
 
 #include "cbvh/traversal_units.h"
 #include "exact_wide.h"
+#include "fast_paths.h"
 #include "ray_sphere_internal.h"
 
 static uint32_t check(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r) {
@@ -258,11 +259,7 @@ uint32_t cbvh_ray_sphere(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r, i
     *hit = 0;
     uint32_t st = check(ray, c, r);
     if (st || empty_segment(ray)) return st;
-#ifndef CBVH_NO_FAST_PATHS /* a test build: ray_box_f64.h */
-    int f = fast_decide(ray, c, r);
-#else
-    int f = -1;
-#endif
+    int f = CBVH_FAST_PATHS ? fast_decide(ray, c, r) : -1;
     *hit = f >= 0 ? f : exact_decide(ray, c, r);
     return 0;
 }

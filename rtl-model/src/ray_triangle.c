@@ -16,6 +16,7 @@
 
 #include "cbvh/traversal_units.h"
 #include "exact_wide.h"
+#include "fast_paths.h"
 #include "ray_prep.h"
 
 uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
@@ -264,11 +265,7 @@ static int verts_bad(const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 
 
 uint32_t cbvh_ray_triangle_prepared(const cbvh_tri_ray *p, const cbvh_ray *ray, const cbvh_f32 v0[3],
                                     const cbvh_f32 v1[3], const cbvh_f32 v2[3], cbvh_tri_result *out) {
-#ifndef CBVH_NO_FAST_PATHS /* a test build: ray_box_f64.h */
-    if (p->ok && !verts_bad(v0, v1, v2)) {
-#else
-    if (0) {
-#endif
+    if (CBVH_FAST_PATHS && p->ok && !verts_bad(v0, v1, v2)) {
         int f = filter(p, v0, v1, v2, 1, out);
         if (f == 1) memset(out, 0, sizeof *out); /* the exact path's miss */
         if (f) return 0;

@@ -41,10 +41,8 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     cbvh_rbf_ray fp;
     cbvh_rbf_prepare(ray, mant_bits, &fp);
     const cbvh_params *prm = &t->params;
-    int fast_codec = cbvh_fast_params_ok(prm) && t->pair_bytes == cbvh_nodepair_bytes(prm->quant_bits);
-#ifdef CBVH_NO_FAST_PATHS /* a test build: ray_box_f64.h */
-    fast_codec = 0;
-#endif
+    int fast_codec = CBVH_FAST_PATHS && cbvh_fast_params_ok(prm) &&
+                     t->pair_bytes == cbvh_nodepair_bytes(prm->quant_bits);
 
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;

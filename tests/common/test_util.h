@@ -42,6 +42,23 @@ static inline uint32_t tu_xorshift32(uint32_t *s) {
 static inline double tu_unit_d(uint64_t *s) { return (double)(tu_xorshift64(s) >> 11) / 9007199254740992.0; }
 static inline float tu_unit_f(uint64_t *s) { return (float)tu_unit_d(s); }
 
+/* An output digest, FNV-1a 64 over the bytes of each value (low byte
+ * first): two builds of a test agree iff their digests do. */
+typedef struct {
+    uint64_t h;
+} digest;
+static inline void digest_init(digest *d) { d->h = UINT64_C(0xCBF29CE484222325); }
+static inline void digest_u32(digest *d, uint32_t v) {
+    for (int i = 0; i < 4; i++) {
+        d->h ^= (v >> (8 * i)) & 0xFFu;
+        d->h *= UINT64_C(0x100000001B3);
+    }
+}
+static inline void digest_u64(digest *d, uint64_t v) {
+    digest_u32(d, (uint32_t)v);
+    digest_u32(d, (uint32_t)(v >> 32));
+}
+
 /* binary32 bit pattern of a float, and back (short names for the tests). */
 static inline cbvh_f32 fb(float f) { return cbvh_f32_of(f); }
 static inline float bf(cbvh_f32 b) { return cbvh_float_of(b); }

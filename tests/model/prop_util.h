@@ -94,17 +94,7 @@ static inline cbvh_f32 prop_point_in(prng *r, cbvh_f32 lo, cbvh_f32 hi) {
     }
 }
 
-/* ---- digest: FNV-1a 64 over every model output ---- */
-typedef struct {
-    uint64_t h;
-} digest;
-static inline void digest_init(digest *d) { d->h = UINT64_C(0xCBF29CE484222325); }
-static inline void digest_u32(digest *d, uint32_t v) {
-    for (int i = 0; i < 4; i++) {
-        d->h ^= (v >> (8 * i)) & 0xFFu;
-        d->h *= UINT64_C(0x100000001B3);
-    }
-}
+/* ---- digest (test_util.h) of an axis unit's outputs ---- */
 static inline void digest_code(digest *d, uint32_t st, const cbvh_axis_code *c) {
     digest_u32(d, st);
     digest_u32(d, c->lb_mod);

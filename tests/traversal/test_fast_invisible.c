@@ -43,13 +43,9 @@ static uint64_t rs = 0x2545F4914F6CDD1Du;
 static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static float rndf(void) { return (float)(rnd() & 0xFFFFFF) / 16777216.0f; }
 
-static uint64_t digest = 0xCBF29CE484222325u, traversals, hits, vertex_rays;
-static void dg(uint64_t v) {
-    for (int i = 0; i < 8; i++) {
-        digest ^= (v >> (8 * i)) & 0xFFu;
-        digest *= 0x100000001B3u;
-    }
-}
+static digest dgst;
+static uint64_t traversals, hits, vertex_rays;
+static void dg(uint64_t v) { digest_u64(&dgst, v); }
 
 static void record(int rc, const cbvh_trav_hit *h, const cbvh_trav_stats *st) {
     traversals++;
@@ -247,6 +243,7 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
+    digest_init(&dgst);
     for (int k = 0; k < SCENES; k++) run_scene(k);
 #ifdef CBVH_NO_FAST_PATHS
     const char *build = "exact paths only";
@@ -255,7 +252,7 @@ int main(int argc, char **argv) {
 #endif
     printf("%s: %llu traversals (%llu with a hit), %llu rays through a vertex at t = k; digest %016llx\n", build,
            (unsigned long long)traversals, (unsigned long long)hits, (unsigned long long)vertex_rays,
-           (unsigned long long)digest);
+           (unsigned long long)dgst.h);
     if (vertex_rays < RAYS || hits < traversals / 4) {
         fprintf(stderr, "FAIL too few vertex rays (%llu) or hits (%llu): the comparison would be vacuous\n",
                 (unsigned long long)vertex_rays, (unsigned long long)hits);
@@ -263,7 +260,7 @@ int main(int argc, char **argv) {
     }
     if (out) {
         FILE *f = fopen(out, "w");
-        if (!f || fprintf(f, "%016llx\n", (unsigned long long)digest) < 0 || fclose(f)) {
+        if (!f || fprintf(f, "%016llx\n", (unsigned long long)dgst.h) < 0 || fclose(f)) {
             fprintf(stderr, "cannot write %s\n", out);
             return 1;
         }
