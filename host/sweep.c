@@ -215,7 +215,7 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
     if (run_one(&c, &res->ref, CBVH_FORMAT_FLOAT, NULL, err, errlen)) goto out;
     res->ref_rays = c.nrec;
     res->all_same = 1;
-    char label[48];
+    char label[72]; /* a format name (47 chars) and " M=" with its value fit */
     for (int i = 0; i < res->nrows; i++) {
         cbvh_sweep_run_t *run = &res->rows[i];
         snprintf(label, sizeof label, "N=%d M=%d E=%d", run->s.bits, run->s.mant, run->s.min_scale);

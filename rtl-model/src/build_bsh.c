@@ -251,7 +251,7 @@ int cbvh_bsh_check(const cbvh_bsh *h, const cbvh_scene *s, char *err, size_t err
         return -1;
     }
     uint8_t *seen = calloc(s->ntris, 1);
-    uint32_t *parent = malloc((size_t)h->nnodes * sizeof *parent);
+    uint32_t *parent = malloc((size_t)h->nnodes * sizeof *parent), *depth = NULL;
     int rc = -1;
     if (!seen || !parent) {
         snprintf(err, errlen, "bsh check: out of memory");
@@ -273,6 +273,10 @@ int cbvh_bsh_check(const cbvh_bsh *h, const cbvh_scene *s, char *err, size_t err
             snprintf(err, errlen, "bsh: node %u triangle range out of bounds", i);
             goto out;
         }
+        if (h->nchild[i] > 8) { /* an octant split: the list builder's scratch holds 8 */
+            snprintf(err, errlen, "bsh: node %u has %u children (at most 8)", i, h->nchild[i]);
+            goto out;
+        }
         if (h->nchild[i] && (h->first_child[i] <= i || (uint64_t)h->first_child[i] + h->nchild[i] > h->nnodes)) {
             snprintf(err, errlen, "bsh: node %u child range [%u, +%u) invalid", i, h->first_child[i], h->nchild[i]);
             goto out;
@@ -291,6 +295,23 @@ int cbvh_bsh_check(const cbvh_bsh *h, const cbvh_scene *s, char *err, size_t err
             snprintf(err, errlen, "bsh: node %u unreachable", i);
             goto out;
         }
+    /* The recorded depth sizes the list builder's scratch: it must be the
+     * hierarchy's (children have larger indices than their parent). */
+    depth = malloc((size_t)h->nnodes * sizeof *depth);
+    if (!depth) {
+        snprintf(err, errlen, "bsh check: out of memory");
+        goto out;
+    }
+    uint32_t deepest = 0;
+    depth[0] = 0;
+    for (uint32_t i = 1; i < h->nnodes; i++) {
+        depth[i] = depth[parent[i]] + 1;
+        if (depth[i] > deepest) deepest = depth[i];
+    }
+    if (h->depth != deepest) {
+        snprintf(err, errlen, "bsh: depth recorded as %u, the hierarchy is %u deep", h->depth, deepest);
+        goto out;
+    }
     if (h->ntri_ids != s->ntris) {
         snprintf(err, errlen, "bsh: %u triangle slots for %u triangles", h->ntri_ids, s->ntris);
         goto out;
@@ -314,9 +335,17 @@ int cbvh_bsh_check(const cbvh_bsh *h, const cbvh_scene *s, char *err, size_t err
                 if (a == 0) break;
             }
         }
+    /* ntri_ids == ntris and no triangle twice: a missing one leaves a slot
+     * unused, which the loop above does not see. */
+    for (uint32_t t = 0; t < s->ntris; t++)
+        if (!seen[t]) {
+            snprintf(err, errlen, "bsh: triangle %u is in no node", t);
+            goto out;
+        }
     rc = 0;
 out:
     free(seen);
     free(parent);
+    free(depth);
     return rc;
 }

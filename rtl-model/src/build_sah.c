@@ -147,8 +147,10 @@ int cbvh_build_sah(const cbvh_scene *s, int bins, int max_leaf, cbvh_bvh *out, c
     free(cen);
     free(tmp);
     free(stack);
-    out->nodes = realloc(nodes, (size_t)nn * sizeof *nodes);
-    if (!out->nodes) out->nodes = nodes;
+    /* Shrink to the nodes used; if the smaller block cannot be had, keep the
+     * larger one (realloc left it untouched). */
+    cbvh_bvh_node *shrunk = realloc(nodes, (size_t)nn * sizeof *nodes);
+    out->nodes = shrunk ? shrunk : nodes;
     out->nnodes = nn;
     out->root = 0;
     out->prims = prims;

@@ -98,7 +98,7 @@ int cbvh_bvh_check(const cbvh_bvh *b, const cbvh_scene *s, char *err, size_t err
                 prims++;
                 cbvh_tri_bounds(&s->tris[p], lo, hi);
                 for (int a = 0; a < 3; a++)
-                    if (lo[a] < n->lo[a] || hi[a] > n->hi[a]) {
+                    if (!(n->lo[a] <= lo[a] && hi[a] <= n->hi[a])) { /* NaN boxes fail too */
                         snprintf(err, errlen, "bvh: leaf %u does not enclose triangle %u", i, p);
                         goto out;
                     }
@@ -107,7 +107,7 @@ int cbvh_bvh_check(const cbvh_bvh *b, const cbvh_scene *s, char *err, size_t err
             for (int c = 0; c < 2; c++) {
                 const cbvh_bvh_node *ch = &b->nodes[n->child[c] < b->nnodes ? n->child[c] : i];
                 for (int a = 0; a < 3; a++)
-                    if (ch->lo[a] < n->lo[a] || ch->hi[a] > n->hi[a]) {
+                    if (!(n->lo[a] <= ch->lo[a] && ch->hi[a] <= n->hi[a])) {
                         snprintf(err, errlen, "bvh: node %u does not enclose child %u", i, n->child[c]);
                         goto out;
                     }

@@ -147,6 +147,23 @@ int cbvh_tree_check(const cbvh_tree *t, const cbvh_bvh *b, char *err, size_t err
         snprintf(err, errlen, "cbvh check: bad root pair or ID count");
         goto out;
     }
+    /* The root box is the first thing every ray is tested against, and its
+     * context decodes the whole tree: both must be the BVH root's. */
+    const cbvh_bvh_node *r = &b->nodes[b->root < b->nnodes ? b->root : 0];
+    for (int a = 0; a < 3; a++) {
+        cbvh_axis_ctx want;
+        if (t->root_lo[a] != cbvh_f32_of(r->lo[a]) || t->root_hi[a] != cbvh_f32_of(r->hi[a]) ||
+            cbvh_axis_root_ctx(&t->params, t->root_lo[a], t->root_hi[a], &want)) {
+            snprintf(err, errlen, "cbvh check: root box axis %d is not the BVH root's box", a);
+            goto out;
+        }
+        const cbvh_axis_ctx *c = &t->root_ctx.axis[a];
+        if (c->parent_scale != want.parent_scale || c->scale != want.scale || c->lb_mod != want.lb_mod ||
+            c->clb != want.clb) {
+            snprintf(err, errlen, "cbvh check: root context axis %d does not match the root box", a);
+            goto out;
+        }
+    }
     stack[sp++] = (item){t->root_pair, b->root, t->root_ctx};
     while (sp) {
         item it = stack[--sp];

@@ -515,8 +515,37 @@ static void test_scene_validate(void **st) {
     cbvh_bvh b;
     assert_int_equal(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf), -1);
     assert_int_equal(cbvh_build_sah(&s, 0, 0, &b, errbuf, sizeof errbuf), -1);
+    s.tris[7].v[1][2] = 0.5f;
+    /* Morph targets are validated too: one target, a copy of the base, is
+     * fine; a NaN in it is named. */
+    s.nmorph = 1;
+    s.morph = malloc(s.ntris * sizeof *s.morph);
+    assert_non_null(s.morph);
+    memcpy(s.morph, s.tris, s.ntris * sizeof *s.morph);
+    assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), 0);
+    s.morph[9].v[2][0] = NAN;
+    assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), -1);
+    assert_non_null(strstr(errbuf, "morph target has a non-finite"));
+    s.morph[9].v[2][0] = 0.0f;
+    /* The SAH builder's parameters: 4..64 bins, 1..64 per leaf (0: default). */
+    const int bad_params[][2] = {{3, 4}, {65, 4}, {16, 65}, {-1, 4}, {16, -1}};
+    for (size_t i = 0; i < sizeof bad_params / sizeof bad_params[0]; i++) {
+        assert_int_equal(cbvh_build_sah(&s, bad_params[i][0], bad_params[i][1], &b, errbuf, sizeof errbuf), -1);
+        assert_non_null(strstr(errbuf, "bins must be 4..64"));
+    }
+    no_error(cbvh_build_sah(&s, 4, 64, &b, errbuf, sizeof errbuf));
+    cbvh_bvh_free(&b);
+    /* Primitive IDs are 31 bits: a count past that is refused before any
+     * triangle is read. */
+    s.ntris = 0x80000000u;
+    assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), -1);
+    assert_non_null(strstr(errbuf, "IDs must fit in 31 bits"));
+    s.ntris = 10;
+    cbvh_scene_free(&s);
+    random_scene(&s, 10, 1.0f, 0.1f);
     s.ntris = 0;
     assert_int_equal(cbvh_scene_validate(&s, errbuf, sizeof errbuf), -1);
+    assert_non_null(strstr(errbuf, "no triangles"));
     cbvh_scene_free(&s);
 }
 
@@ -582,6 +611,76 @@ static void test_lbvh_equal_codes_share_leaf(void **st) {
     cbvh_scene_free(&s);
 }
 
+/* The Morton order is pinned (docs/study.md): triangles centred on grid cells
+ * of a scene whose centre bounds are exactly [0, 1024]^3, so the cell is
+ * floor(centre); the leaves, in node order, must list the triangles in the
+ * order of x9 y9 z9 x8 ... z0 codes computed here bit by bit, equal codes in
+ * one leaf (in triangle order: the sort is stable), distinct codes apart. */
+static uint32_t morton_ref(const uint32_t k[3]) {
+    uint32_t code = 0;
+    for (int bit = 9; bit >= 0; bit--)
+        for (int a = 0; a < 3; a++) code = code << 1 | (k[a] >> bit & 1u);
+    return code;
+}
+
+static void test_lbvh_morton_order(void **st) {
+    (void)st;
+    enum { N = 3000 };
+    cbvh_scene s;
+    memset(&s, 0, sizeof s);
+    s.ntris = N;
+    s.tris = calloc(N, sizeof *s.tris);
+    assert_non_null(s.tris);
+    uint32_t *code = malloc(N * sizeof *code);
+    assert_non_null(code);
+    for (uint32_t i = 0; i < N; i++) {
+        uint32_t k[3];
+        for (int a = 0; a < 3; a++) {
+            /* Triangles 0 and 1 fix the centre bounds at 0 and 1024; every
+             * eighth repeats its predecessor's cell (a shared leaf). */
+            k[a] = i == 0 ? 0u : i == 1 ? 1023u : (i % 8 == 0) ? 0u : rnd() & 1023u;
+        }
+        if (i > 1 && i % 8 == 0) {
+            s.tris[i] = s.tris[i - 1];
+            code[i] = code[i - 1];
+            continue;
+        }
+        float c[3];
+        for (int a = 0; a < 3; a++) c[a] = i == 1 ? 1024.0f : i == 0 ? 0.0f : (float)k[a] + 0.5f;
+        /* Box centre lo/2 + hi/2 = c exactly. */
+        const float d = 0.25f;
+        float v[3][3] = {{c[0] - d, c[1] - d, c[2] - d}, {c[0] + d, c[1] - d, c[2] + d}, {c[0], c[1] + d, c[2]}};
+        memcpy(&s.tris[i], v, sizeof v);
+        code[i] = morton_ref(k);
+    }
+    cbvh_bvh b;
+    no_error(cbvh_build_lbvh(&s, &b, errbuf, sizeof errbuf));
+    no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+    uint32_t leaves, inner, seen = 0, prev_code = 0, prev_prim = 0;
+    cbvh_bvh_counts(&b, &leaves, &inner);
+    for (uint32_t li = 0; li < leaves; li++) {
+        const cbvh_bvh_node *n = &b.nodes[inner + li]; /* leaves follow the inner nodes */
+        assert_true(cbvh_bvh_is_leaf(n));
+        for (uint32_t j = 0; j < n->count; j++, seen++) {
+            uint32_t p = b.prims[n->first + j];
+            if (seen) {
+                if (j == 0)
+                    assert_true(code[p] > prev_code); /* a new leaf: a new, larger code */
+                else {
+                    assert_int_equal(code[p], prev_code); /* one code per leaf */
+                    assert_true(p > prev_prim);           /* stable */
+                }
+            }
+            prev_code = code[p];
+            prev_prim = p;
+        }
+    }
+    assert_int_equal(seen, N);
+    cbvh_bvh_free(&b);
+    free(code);
+    cbvh_scene_free(&s);
+}
+
 static void test_sah_valid_and_better(void **st) {
     (void)st;
     cbvh_scene s;
@@ -595,6 +694,21 @@ static void test_sah_valid_and_better(void **st) {
     assert_true(cs < cl); /* SAH optimises the cost LBVH ignores */
     for (uint32_t i = 0; i < sah.nnodes; i++)
         if (cbvh_bvh_is_leaf(&sah.nodes[i])) assert_true(sah.nodes[i].count <= 4);
+    /* 0, 0 means the documented defaults, 16 bins and 4 per leaf: the same
+     * tree node for node (and 15 bins or 3 per leaf a different one, so the
+     * comparison can fail). */
+    cbvh_bvh dflt, other;
+    no_error(cbvh_build_sah(&s, 0, 0, &dflt, errbuf, sizeof errbuf));
+    assert_int_equal(dflt.nnodes, sah.nnodes);
+    assert_memory_equal(dflt.nodes, sah.nodes, sah.nnodes * sizeof *sah.nodes);
+    assert_memory_equal(dflt.prims, sah.prims, sah.nprims * sizeof *sah.prims);
+    cbvh_bvh_free(&dflt);
+    const int variants[2][2] = {{15, 4}, {16, 3}};
+    for (int v = 0; v < 2; v++) {
+        no_error(cbvh_build_sah(&s, variants[v][0], variants[v][1], &other, errbuf, sizeof errbuf));
+        assert_true(other.nnodes != sah.nnodes || memcmp(other.nodes, sah.nodes, sah.nnodes * sizeof *sah.nodes) != 0);
+        cbvh_bvh_free(&other);
+    }
     cbvh_bvh_free(&sah);
     cbvh_bvh_free(&lb);
     cbvh_scene_free(&s);
@@ -653,6 +767,44 @@ static void check_both(cbvh_bvh *b, int n, int min_scale, cbvh_encoding enc) {
     }
     cbvh_tree_free(&td);
     cbvh_tree_free(&bu);
+}
+
+/* A malformed float BVH (a box inverted, a NaN bound, a child far outside
+ * its parent's grid) is refused by both compressors, each naming the pair
+ * the encoder rejected with the unit's status, and leaves no tree behind. */
+static void test_compress_malformed(void **st) {
+    (void)st;
+    cbvh_scene s;
+    load_bunny(&s);
+    cbvh_bvh b;
+    no_error(cbvh_build_sah(&s, 0, 0, &b, errbuf, sizeof errbuf));
+    const uint32_t c0 = b.nodes[b.root].child[0], g = b.nodes[c0].child[0];
+    assert_false(cbvh_bvh_is_leaf(&b.nodes[c0]));
+    const cbvh_bvh_node saved = b.nodes[g];
+    static const char *const status[3] = {"status 0x2)", "status 0x1)", "status 0x40)"};
+    for (int m = 0; m < 3; m++)
+        for (int enc = 0; enc < 2; enc++) {
+            b.nodes[g] = saved;
+            if (m == 0) b.nodes[g].hi[0] = b.nodes[g].lo[0] - 0.01f; /* inverted: INVERTED */
+            if (m == 1) b.nodes[g].lo[1] = NAN;                       /* NAN_INF */
+            if (m == 2) b.nodes[g].hi[0] = b.nodes[c0].hi[0] + 100.0f; /* NO_FIT on its parent's grid */
+            cbvh_compress_opts o = opts(6, -30, enc ? CBVH_ENC_RELATIVE : CBVH_ENC_MODULO, 4);
+            cbvh_tree t;
+            cbvh_bu_stats bs;
+            memset(&t, 0x5A, sizeof t);
+            assert_int_equal(cbvh_compress_topdown(&b, &o, &t, errbuf, sizeof errbuf), -1);
+            assert_non_null(strstr(errbuf, "cbvh top-down: pair "));
+            assert_non_null(strstr(errbuf, status[m]));
+            assert_null(t.pairs);
+            memset(&t, 0x5A, sizeof t);
+            assert_int_equal(cbvh_compress_bottomup(&b, NULL, &o, &t, &bs, errbuf, sizeof errbuf), -1);
+            assert_non_null(strstr(errbuf, "cbvh bottom-up: pair "));
+            assert_non_null(strstr(errbuf, status[m]));
+            assert_null(t.pairs);
+        }
+    b.nodes[g] = saved;
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
 }
 
 static void test_compress_bunny(void **st) {
@@ -1048,9 +1200,11 @@ int main(void) {
         cmocka_unit_test(test_scene_validate),
         cmocka_unit_test(test_lbvh_valid),
         cmocka_unit_test(test_lbvh_equal_codes_share_leaf),
+        cmocka_unit_test(test_lbvh_morton_order),
         cmocka_unit_test(test_sah_valid_and_better),
         cmocka_unit_test(test_sah_cost_formula),
         cmocka_unit_test(test_compress_bunny),
+        cmocka_unit_test(test_compress_malformed),
         cmocka_unit_test(test_compress_hard_scenes),
         cmocka_unit_test(test_compress_huge_range),
         cmocka_unit_test(test_compress_single_leaf_root),

@@ -141,6 +141,187 @@ static void past_limit(void) {
     cbvh_qbvh_free(&q);
 }
 
+/* A QBVH with a cycle (which cbvh_qbvh_check refuses, but the traversal must
+ * not trust): (a) node 0's only child is node 0, no stack entry; (b) node 2's
+ * children are node 1 (a leaf) and node 2, one stack entry per visit.  Every
+ * box holds the ray.  The traversal must stop after nnodes inner-node visits
+ * with -1 and no hit, for every stack kind, instead of looping. */
+static void cyclic(void) {
+    cbvh_tri tris[1] = {{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}};
+    float bmin[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    float bmax[3][4] = {{1, 1, 2, 0}, {1, 1, 0, 0}, {1, 1, 2, 0}};
+    uint32_t prims[1] = {0};
+    uint32_t first_a[1] = {0}, count_a[1] = {1};
+    uint32_t first_b[3] = {1, 0, 1}, count_b[3] = {2, 1 | CBVH_QBVH_LEAF, 2};
+    cbvh_qbvh qa = {1, bmin, bmax, first_a, count_a, prims, 1, 0, 1};
+    cbvh_qbvh qb = {3, bmin, bmax, first_b, count_b, prims, 1, 1, 2};
+    char err[200];
+    tris[0].v[0][2] = tris[0].v[1][2] = tris[0].v[2][2] = 0.0f;
+    CHECK(cbvh_qbvh_check(&qb, &(cbvh_scene){.tris = tris, .ntris = 1}, err, sizeof err) == -1,
+          "the structure check accepts a cyclic QBVH");
+    cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(3.0f)}, {0, 0, fb(-1.0f)}, 0, CBVH_F32_POS_INF};
+    const cbvh_qbvh *qs[2] = {&qa, &qb};
+    for (int t = 0; t < 2; t++)
+        for (int k = 1; k <= 3; k++)
+            for (int mode = 0; mode < 2; mode++) {
+                cbvh_trav_hit h;
+                cbvh_trav_stats st = {0};
+                int rc = cbvh_trace_qbvh(qs[t], tris, &r, 24, mode ? CBVH_TRAV_ANY : CBVH_TRAV_CLOSEST,
+                                         (cbvh_qstack_kind)k, &h, &st);
+                CHECK(rc == -1 && !h.hit && st.nodes == qs[t]->nnodes,
+                      "cyclic QBVH %c, stack kind %d, %s: rc %d hit %d after %llu inner-node visits", 'a' + t, k,
+                      mode ? "any" : "closest", rc, h.hit, (unsigned long long)st.nodes);
+            }
+}
+
+/* A valid chain QBVH D inner nodes deep: inner node k's children are inner
+ * node k+1 (the nearer) and leaves holding triangles at z = -(k+1) - j/4
+ * (deferred): one leaf under the root, w (1 or 2) under every other inner
+ * node; the last inner node has a leaf in place of inner node D.  A ray down
+ * -z defers them all, so at the bottom the compressed and wide stacks hold D
+ * entries and the plain stack 1 + w(D-1).  Where that fits CBVH_TRAV_STACK
+ * the closest hit is triangle 0 at t = D + 11; where not, the traversal
+ * stops with -1 and no hit, its deepest stack the last that fitted.  Also: an
+ * unknown stack kind is refused. */
+static void deep_chain(int D, int w) {
+    cbvh_qbvh q = {0};
+    uint32_t ntri = 2u + (uint32_t)w * (uint32_t)(D - 1);
+    q.nnodes = 2u + (1u + (uint32_t)w) * (uint32_t)(D - 1) + 1u;
+    q.bmin = calloc(q.nnodes, sizeof *q.bmin);
+    q.bmax = calloc(q.nnodes, sizeof *q.bmax);
+    q.first = calloc(q.nnodes, sizeof *q.first);
+    q.count = calloc(q.nnodes, sizeof *q.count);
+    q.prims = malloc(ntri * sizeof *q.prims);
+    cbvh_tri *tris = calloc(ntri, sizeof *tris);
+    if (!q.bmin || !q.bmax || !q.first || !q.count || !q.prims || !tris) {
+        CHECK(0, "cannot allocate the chain");
+        cbvh_qbvh_free(&q);
+        free(tris);
+        return;
+    }
+    q.nprims = ntri;
+    for (uint32_t n = 0; n < q.nnodes; n++) q.bmax[n][0] = q.bmax[n][1] = 1; /* x, y in [0, 1] */
+    uint32_t self = 0, next = 1, prim = 0;
+    for (int k = 0; k < D; k++) {
+        int leaves = k == 0 ? 1 : w, last = k == D - 1;
+        uint32_t g = next;
+        next += 1u + (uint32_t)leaves;
+        q.bmin[self][2] = -(float)(D + 2);
+        q.bmax[self][2] = (float)(D + 1 - k);
+        q.first[self] = g;
+        q.count[self] = 1u + (uint32_t)leaves;
+        if (g > q.max_first) q.max_first = g;
+        for (int j = 0; j <= leaves; j++) {
+            uint32_t n = g + (uint32_t)j;
+            if (j == 0 && !last) continue; /* inner node k+1, filled next */
+            float z = j == 0 ? -(float)(D + 1) : -(float)(k + 1) - 0.25f * (float)(j - 1);
+            cbvh_tri t = {{{0, 0, z}, {1, 0, z}, {0, 1, z}}};
+            tris[prim] = t;
+            q.prims[prim] = prim;
+            q.first[n] = prim++;
+            q.count[n] = 1 | CBVH_QBVH_LEAF;
+            q.bmin[n][2] = q.bmax[n][2] = z;
+        }
+        self = g;
+    }
+    q.depth = (uint32_t)D;
+    char err[200];
+    cbvh_scene sc = {.tris = tris, .ntris = ntri};
+    CHECK(prim == ntri && next == q.nnodes, "chain of %d: %u triangles, %u nodes laid out", D, prim, next);
+    CHECK(cbvh_qbvh_check(&q, &sc, err, sizeof err) == 0, "chain of %d: %s", D, err);
+    uint32_t z0 = 0; /* the triangle at z = -1: the closest */
+    while (z0 < ntri && tris[z0].v[0][2] != -1.0f) z0++;
+    cbvh_ray r = {{fb(0.25f), fb(0.25f), fb((float)(D + 10))}, {0, 0, fb(-1.0f)}, 0, CBVH_F32_POS_INF};
+    for (int k = 1; k <= 3; k++) {
+        int per = k == CBVH_QSTACK_PLAIN ? w : 1; /* entries per inner node below the root */
+        int need = 1 + per * (D - 1), fits = need <= CBVH_TRAV_STACK;
+        int deepest = fits ? need : need - per * ((need - CBVH_TRAV_STACK + per - 1) / per);
+        cbvh_trav_hit h;
+        cbvh_trav_stats st = {0};
+        int rc = cbvh_trace_qbvh(&q, tris, &r, 24, CBVH_TRAV_CLOSEST, (cbvh_qstack_kind)k, &h, &st);
+        CHECK(fits ? rc == 0 && h.hit && h.prim == z0 && h.t == fb((float)(D + 11)) : rc == -1 && !h.hit,
+              "chain of %d (w %d), stack kind %d: rc %d hit %d prim %u t %08x (stack needs %d of %d)", D, w, k, rc,
+              h.hit, h.prim, h.t, need, CBVH_TRAV_STACK);
+        CHECK(st.max_stack == (uint32_t)deepest, "chain of %d (w %d), stack kind %d: deepest stack %u, want %d", D,
+              w, k, st.max_stack, deepest);
+    }
+    cbvh_trav_hit h;
+    cbvh_trav_stats st = {0};
+    CHECK(cbvh_qbvh_stack_check(&q, (cbvh_qstack_kind)7, err, sizeof err) == -1 && strstr(err, "unknown stack kind"),
+          "stack kind 7 accepted");
+    CHECK(cbvh_trace_qbvh(&q, tris, &r, 24, CBVH_TRAV_CLOSEST, (cbvh_qstack_kind)7, &h, &st) == -1 && !h.hit &&
+              st.nodes == 0,
+          "traversal with stack kind 7 not refused");
+    cbvh_qbvh_free(&q);
+    free(tris);
+}
+
+/* Lines a run of n bytes at a touches (64-byte lines). */
+static uint64_t lines_of(uint64_t a, uint64_t n) { return (a + n - 1) / 64 - a / 64 + 1; }
+
+static uint64_t align64(uint64_t a) { return (a + 63) / 64 * 64; }
+
+/* The QBVH memory image (docs/qbvh.md §3 and §4: bmin, bmax, info, IDs,
+ * triangles, each region line-aligned; a visit fetches its children's three
+ * runs of 16k, 16k and 8k bytes).  A sparse QBVH: the root's four leaf
+ * children start at node f (1..40), each leaf holds one ID; the hit leaf c's
+ * ID is in slot p of 64 and names triangle id.  The line count must be the
+ * image's: the root's three runs, the ID word and the triangle's 36 bytes. */
+static void memory_map(void) {
+    cbvh_tri tris[16];
+    for (int i = 0; i < 16; i++) {
+        cbvh_tri t = {{{0, 0, 0.5f}, {1, 0, 0.5f}, {0, 1, 0.5f}}};
+        tris[i] = t;
+    }
+    long bad = 0;
+    for (uint32_t f = 1; f <= 40; f++)
+        for (uint32_t c = 0; c < 4; c++)
+            for (uint32_t p = 0; p < 64; p++) {
+                enum { MAXN = 44, NP = 64 };
+                uint32_t id = (p * 7u + f) % 16u;
+                float bmin[MAXN][4] = {{0}}, bmax[MAXN][4] = {{0}};
+                uint32_t first[MAXN] = {0}, count[MAXN] = {0}, prims[NP];
+                for (uint32_t i = 0; i < NP; i++) prims[i] = (id + 1u + i) % 16u;
+                cbvh_qbvh q = {f + 4, bmin, bmax, first, count, prims, NP, f, 1};
+                bmax[0][0] = 8;
+                bmax[0][1] = bmax[0][2] = 1;
+                first[0] = f;
+                count[0] = 4;
+                for (uint32_t k = 0; k < 4; k++) {
+                    uint32_t n = f + k;
+                    bmin[n][0] = 2.0f * (float)k; /* leaf k spans x in [2k, 2k + 1] */
+                    bmax[n][0] = 2.0f * (float)k + 1;
+                    bmax[n][1] = bmax[n][2] = 1;
+                    first[n] = k == c ? p : (p + 1u + k) % NP;
+                    count[n] = 1 | CBVH_QBVH_LEAF;
+                }
+                prims[p] = id;
+                cbvh_tri local[16]; /* the hit triangle moved under leaf c */
+                memcpy(local, tris, sizeof local);
+                for (int v = 0; v < 3; v++) local[id].v[v][0] += 2.0f * (float)c;
+                uint64_t bmax_base = align64(16u * q.nnodes), info_base = bmax_base + align64(16u * q.nnodes);
+                uint64_t ids_base = info_base + align64(8u * q.nnodes), tris_base = align64(ids_base + 4u * NP);
+                uint64_t want = lines_of(16u * f, 64) + lines_of(bmax_base + 16u * f, 64) +
+                                lines_of(info_base + 8u * f, 32) + lines_of(ids_base + 4u * p, 4) +
+                                lines_of(tris_base + 36u * id, 36);
+                cbvh_ray r = {{fb(2.0f * (float)c + 0.25f), fb(0.25f), fb(2)}, {0, 0, fb(-1)}, 0, CBVH_F32_POS_INF};
+                for (int k = 1; k <= 3; k++) {
+                    cbvh_trav_hit h;
+                    cbvh_trav_stats st = {0};
+                    int rc = cbvh_trace_qbvh(&q, local, &r, 24, CBVH_TRAV_CLOSEST, (cbvh_qstack_kind)k, &h, &st);
+                    if (rc || !h.hit || h.prim != id || st.nodes != 1 || st.tri_tests != 1 || st.lines != want ||
+                        st.bytes != 64 * want) {
+                        if (bad++ < 5)
+                            printf("FAIL memory map: first child %u, leaf %u, ID slot %u, triangle %u, stack kind %d: "
+                                   "rc %d hit %d prim %u, %llu lines / %llu bytes, want %llu\n",
+                                   f, c, p, id, k, rc, h.hit, h.prim, (unsigned long long)st.lines,
+                                   (unsigned long long)st.bytes, (unsigned long long)want);
+                    }
+                }
+            }
+    fails += (int)bad;
+}
+
 int main(void) {
 #ifdef CBVH_SANITIZE
     int n = 3000;
@@ -151,6 +332,14 @@ int main(void) {
     run_scene("proc:cloth:48", n);
     run_scene("proc:far", n / 2);
     past_limit();
+    cyclic();
+    memory_map();
+    /* The compressed and wide stacks overflow past CBVH_TRAV_STACK inner
+     * nodes; the plain stack with two entries per node at 129. */
+    deep_chain(CBVH_TRAV_STACK, 1);
+    deep_chain(CBVH_TRAV_STACK + 1, 1);
+    deep_chain(CBVH_TRAV_STACK / 2, 2);
+    deep_chain(CBVH_TRAV_STACK / 2 + 1, 2);
     printf("%s (%d failures)\n", fails ? "FAILED" : "ok", fails);
     return fails ? 1 : 0;
 }

@@ -454,6 +454,15 @@ static void bad_input(void) {
     cbvh_tlist_params tp = {3, CBVH_TLIST_EARLIEST_FIRST, 0};
     CHECK(cbvh_tlists_build(&h, &s, &tp, &L, err, sizeof err) == -1 && strstr(err, "1, 2, 6 or 8"), "3 lists accepted");
     tp.nlists = 6;
+    tp.order = (cbvh_tlist_order)2;
+    CHECK(cbvh_tlists_build(&h, &s, &tp, &L, err, sizeof err) == -1 && strstr(err, "unknown node order 2"),
+          "node order 2 accepted");
+    tp.order = CBVH_TLIST_EARLIEST_FIRST;
+    /* a hierarchy built for another scene (here: one triangle more) */
+    s.ntris = 2;
+    CHECK(cbvh_tlists_build(&h, &s, &tp, &L, err, sizeof err) == -1 && strstr(err, "does not match the scene (1 "),
+          "a hierarchy of 1 triangle accepted for 2");
+    s.ntris = 1;
     tp.cull_back = 1;
     CHECK(cbvh_tlists_build(&h, &s, &tp, &L, err, sizeof err) == 0, "%s", err);
     /* the triangle's normal is +z: only the +z sextant never sees its front */

@@ -206,6 +206,15 @@ static void class_rays(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_tlists
 
 /* Pinhole camera, W x W pixels in cells of C x C; corner directions of a cell
  * at the pixel corners, computed like the pixel directions. */
+/* Where a head may point (docs/tlist.md §7): at 0, or at an element whose
+ * predecessor is not a sphere (escape 0 or 1) -- a head backs up over the
+ * spheres whose first child it is, since they may still cull.  Also within
+ * the list. */
+static int head_ok(const cbvh_tlists *L, int l, uint32_t h) {
+    if (h > L->len[l]) return 0;
+    return h == 0 || h == L->len[l] || (L->list[l][h - 1].escape == 0 || L->list[l][h - 1].escape == 1);
+}
+
 static void cell_rays(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_tlists *L, int W, int C, tally *T) {
     float lo[3], hi[3], c[3], ext = 0;
     cbvh_scene_bounds(s, lo, hi);
@@ -234,6 +243,9 @@ static void cell_rays(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_tlists 
             PIXDIR(cor[3], cx, cy + C);
             uint32_t head[CBVH_TLIST_MAX];
             CHECK(cbvh_tlist_cell_heads(L, s->tris, eye, cor, 1e-5, head) == 0, "cell heads");
+            for (int l = 0; l < L->p.nlists; l++)
+                CHECK(head_ok(L, l, head[l]), "cell (%d, %d) list %d: head %u stops right after a sphere", cx, cy, l,
+                      head[l]);
             for (int y = cy; y < cy + C; y++)
                 for (int x = cx; x < cx + C; x++) {
                     float d[3];
@@ -245,6 +257,18 @@ static void cell_rays(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_tlists 
                 }
         }
 #undef PIXDIR
+}
+
+static void check_poly_heads(const cbvh_tlists *L, const char *name) {
+    long bad = 0, past0 = 0;
+    for (uint32_t t = 0; t < L->ntris; t++)
+        for (int l = 0; l < L->p.nlists; l++) {
+            uint32_t h = L->poly_head[(size_t)t * (size_t)L->p.nlists + (size_t)l];
+            bad += !head_ok(L, l, h);
+            past0 += h != 0;
+        }
+    CHECK(bad == 0, "%s: %ld per-polygon heads stop right after a sphere", name, bad);
+    CHECK(past0 > 0, "%s: no per-polygon head past element 0 (the rule was not exercised)", name);
 }
 
 static void run_scene(const char *spec, int nrays, int W) {
@@ -273,6 +297,7 @@ static void run_scene(const char *spec, int nrays, int W) {
         for (int kind = CBVH_TLIST_HEADS_SIMPLE; kind <= CBVH_TLIST_HEADS_REGULAR; kind++) {
             CHECK(cbvh_tlists_poly_heads(&L, s.tris, (cbvh_tlist_heads_kind)kind, margin, err, sizeof err) == 0, "%s",
                   err);
+            check_poly_heads(&L, s.name);
             CHECK(cbvh_tlists_bytes(&L) > (uint64_t)L.ntris * p.nlists * 4u, "bytes count the heads");
             tally T = {0};
             poly_rays(&s, &b, &L, nrays / 16, eps, &T);
@@ -309,6 +334,36 @@ static void run_scene(const char *spec, int nrays, int W) {
     }
     cbvh_bsh_free(&h);
     cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+/* The plane half-space of a simple head, on its own: triangle A in z = 0
+ * facing +z, triangle B a whole unit below it, nothing else.  A ray leaving
+ * A's front toward +z cannot reach B, so A's head in the +z list must start
+ * past B's element (which the list orders first). */
+static void plane_skips(void) {
+    cbvh_scene s;
+    memset(&s, 0, sizeof s);
+    s.ntris = 2;
+    s.tris = calloc(2, sizeof *s.tris);
+    cbvh_tri a = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}, b = {{{0, 0, -1}, {1, 0, -1}, {0, 1, -1}}};
+    s.tris[0] = a;
+    s.tris[1] = b;
+    char err[256];
+    cbvh_bsh h;
+    cbvh_tlists L;
+    cbvh_tlist_params p = {6, CBVH_TLIST_EARLIEST_FIRST, 0};
+    CHECK(cbvh_bsh_build(&s, NULL, &h, err, sizeof err) == 0 && cbvh_tlists_build(&h, &s, &p, &L, err, sizeof err) == 0,
+          "%s", err);
+    CHECK(cbvh_tlists_poly_heads(&L, s.tris, CBVH_TLIST_HEADS_SIMPLE, 0.01f, err, sizeof err) == 0, "%s", err);
+    const float o[3] = {0.25f, 0.25f, 0.0f}, d[3] = {0, 0, 1};
+    cbvh_ray r = mk(o, d, INFINITY);
+    int l = cbvh_tlist_pick(&L, &r);
+    uint32_t eb = elem_of(&L, l, 1), head = L.poly_head[0 * 6 + (uint32_t)l];
+    CHECK(eb != UINT32_MAX && eb < elem_of(&L, l, 0), "list %d: B (element %u) is not before A", l, eb);
+    CHECK(head > eb, "list %d: A's head %u does not skip B (element %u) behind A's plane", l, head, eb);
+    cbvh_tlists_free(&L);
+    cbvh_bsh_free(&h);
     cbvh_scene_free(&s);
 }
 
@@ -355,6 +410,7 @@ int main(void) {
     int n = 8000, W = 64;
 #endif
     bad_input();
+    plane_skips();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj", 2 * n, W);
     run_scene("proc:cloth:32", n, W / 2);
     run_scene("proc:far", n, W / 2);
