@@ -44,6 +44,21 @@ static void refused(int rc, const char *fmt, ...) {
     if (strncmp(err, want, strlen(want)) != 0) fail_msg("got \"%s\", expected \"%s\"", err, want);
 }
 
+/* The index rules every checker shares: ids[0] set to `past` (one past the
+ * valid range), then ids[1] made a copy of ids[0]; each refused with fmt
+ * naming the offending index, and the structure whole again afterwards. */
+typedef int (*check_fn)(const void *obj);
+static void index_cases(uint32_t *ids, uint32_t past, check_fn check, const void *obj, const char *fmt) {
+    const uint32_t i0 = ids[0], i1 = ids[1];
+    ids[0] = past;
+    refused(check(obj), fmt, past);
+    ids[0] = i0;
+    ids[1] = i0;
+    refused(check(obj), fmt, i0);
+    ids[1] = i1;
+    ok(check(obj));
+}
+
 static int group_setup(void **st) {
     (void)st;
     if (cbvh_scene_import(CBVH_SCENES_DIR "/bunny-small.obj", &bunny, err, sizeof err)) {
@@ -62,6 +77,7 @@ static int group_teardown(void **st) {
 /* ---- cbvh_bvh_check ------------------------------------------------------ */
 
 #define BVH_CHECK(b, s) cbvh_bvh_check(b, s, err, sizeof err)
+static int bvh_check_bunny(const void *b) { return BVH_CHECK(b, &bunny); }
 
 static void test_bvh_check(void **st) {
     (void)st;
@@ -108,15 +124,7 @@ static void test_bvh_check(void **st) {
     ok(BVH_CHECK(&b, &bunny));
 
     /* A primitive index past the scene; a primitive listed twice. */
-    uint32_t *p = &b.prims[b.nodes[L2].first];
-    const uint32_t p0 = p[0], p1 = p[1];
-    p[0] = np;
-    refused(BVH_CHECK(&b, &bunny), "bvh: primitive %u missing or in two leaves", np);
-    p[0] = p0;
-    p[1] = p0;
-    refused(BVH_CHECK(&b, &bunny), "bvh: primitive %u missing or in two leaves", p0);
-    p[1] = p1;
-    ok(BVH_CHECK(&b, &bunny));
+    index_cases(&b.prims[b.nodes[L2].first], np, bvh_check_bunny, &b, "bvh: primitive %u missing or in two leaves");
 
     /* Leaf L's box collapsed to its upper corner: inside its parent's, no
      * longer around its first triangle; the root's child 0 one ulp wider than
@@ -324,6 +332,7 @@ static void test_tree_check_root_leaf(void **st) {
 /* ---- cbvh_qbvh_check -------------------------------------------------------- */
 
 #define QBVH_CHECK(q) cbvh_qbvh_check(q, &bunny, err, sizeof err)
+static int qbvh_check_bunny(const void *q) { return QBVH_CHECK(q); }
 
 static void test_qbvh_check(void **st) {
     (void)st;
@@ -362,15 +371,7 @@ static void test_qbvh_check(void **st) {
     ok(QBVH_CHECK(&q));
 
     /* A primitive index past the scene; a primitive listed twice. */
-    uint32_t *p = &q.prims[q.first[L2]];
-    const uint32_t p0 = p[0], p1 = p[1];
-    p[0] = nt;
-    refused(QBVH_CHECK(&q), "qbvh: primitive %u out of range or in two leaves", nt);
-    p[0] = p0;
-    p[1] = p0;
-    refused(QBVH_CHECK(&q), "qbvh: primitive %u out of range or in two leaves", p0);
-    p[1] = p1;
-    ok(QBVH_CHECK(&q));
+    index_cases(&q.prims[q.first[L2]], nt, qbvh_check_bunny, &q, "qbvh: primitive %u out of range or in two leaves");
 
     /* Leaf L's box collapsed to its upper corner: still inside its parent's,
      * no longer around its first triangle. */
@@ -433,6 +434,7 @@ static void test_qbvh_check(void **st) {
 /* ---- cbvh_bsh_check ---------------------------------------------------------- */
 
 #define BSH_CHECK(h) cbvh_bsh_check(h, &bunny, err, sizeof err)
+static int bsh_check_bunny(const void *h) { return BSH_CHECK(h); }
 
 static void test_bsh_check(void **st) {
     (void)st;
@@ -537,15 +539,7 @@ static void test_bsh_check(void **st) {
     ok(BSH_CHECK(&h));
 
     /* A triangle index past the scene; a triangle listed twice. */
-    uint32_t *t = &h.tri_ids[lf];
-    const uint32_t t0 = t[0], t1 = t[1];
-    t[0] = nt;
-    refused(BSH_CHECK(&h), "bsh: triangle %u missing or twice", nt);
-    t[0] = t0;
-    t[1] = t0;
-    refused(BSH_CHECK(&h), "bsh: triangle %u missing or twice", t0);
-    t[1] = t1;
-    ok(BSH_CHECK(&h));
+    index_cases(&h.tri_ids[lf], nt, bsh_check_bunny, &h, "bsh: triangle %u missing or twice");
 
     /* Radius +0 and -0 (-0 is not "negative": it fails as too small) at leaf
      * L, and +0 at the root, which is checked for every triangle. */

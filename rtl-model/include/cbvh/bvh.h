@@ -52,7 +52,8 @@ void cbvh_bvh_postorder(const cbvh_bvh *b, uint32_t *order);
 double cbvh_bvh_sah(const cbvh_bvh *b);
 
 /* Structural check: every node reachable once, every primitive in exactly
- * one leaf, every box encloses its children / triangles.  0 or -1 + reason. */
+ * one leaf, every box encloses its children / triangles (a NaN bound never
+ * does).  0 or -1 + reason. */
 int cbvh_bvh_check(const cbvh_bvh *b, const cbvh_scene *s, char *err, size_t errlen);
 
 /* Leaves and inner nodes reachable from the root. */

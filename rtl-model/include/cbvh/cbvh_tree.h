@@ -95,9 +95,10 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
 int cbvh_build_lbvh_streaming(const cbvh_scene *s, const cbvh_compress_opts *o, cbvh_bvh *bvh, cbvh_tree *out,
                               cbvh_bu_stats *st, char *err, size_t errlen);
 
-/* Decode the whole CBVH and prove it against its float BVH: same topology and
- * leaves, every decoded child box encloses the float box, ID flags right,
- * every pair used once.  0 or -1 + reason (first failure). */
+/* Decode the whole CBVH and prove it against its float BVH: the root box and
+ * its context are the BVH root's, same topology and leaves, every decoded
+ * child box encloses the float box, ID flags right, every pair used once.
+ * 0 or -1 + reason (first failure). */
 int cbvh_tree_check(const cbvh_tree *t, const cbvh_bvh *b, char *err, size_t errlen);
 
 /* SAH cost of the decoded CBVH (same formula as cbvh_bvh_sah, decoded boxes;

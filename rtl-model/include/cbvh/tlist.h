@@ -43,7 +43,9 @@ typedef struct {
 void cbvh_bsh_default_params(cbvh_bsh_params *p);
 int cbvh_bsh_build(const cbvh_scene *s, const cbvh_bsh_params *p, cbvh_bsh *out, char *err, size_t errlen);
 /* Every triangle exactly once; every sphere encloses its triangles' vertices
- * and its children's spheres' contents (checked on vertices).  0 or -1 + reason. */
+ * and its children's spheres' contents (checked on vertices); at most 8
+ * children per node, children after their parent, and `depth` the
+ * hierarchy's (the list builder sizes its scratch by both).  0 or -1 + reason. */
 int cbvh_bsh_check(const cbvh_bsh *h, const cbvh_scene *s, char *err, size_t errlen);
 void cbvh_bsh_free(cbvh_bsh *h);
 
