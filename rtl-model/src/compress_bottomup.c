@@ -464,6 +464,10 @@ general:;
     } else {
         /* cppcheck-suppress nullPointer ; leaf == (cn_in == NULL) */
         for (int c = 0; c < 2; c++) cbvh_child_in_of(cn_in[c], slot[c], &in[c]);
+        if ((uint32_t)(!in[0].leaf + !in[1].leaf) > sp) { /* the inner children were not streamed first */
+            snprintf(s->err, s->errlen, "cbvh bottom-up: pair %u: its inner children came after it (not a tree)", pair);
+            return -1;
+        }
     }
     st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
     if (st & ENC_FAIL) {

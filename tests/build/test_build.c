@@ -745,6 +745,19 @@ static void check_both(cbvh_bvh *b, int n, int min_scale, cbvh_encoding enc) {
     no_error(cbvh_tree_check(&bu, b, errbuf, sizeof errbuf));
     long d = cbvh_tree_diff(&td, &bu);
     if (d != -1) fail_msg("N=%d min_scale=%d enc=%d: bottom-up differs from top-down at byte %ld", n, min_scale, enc, d);
+    /* The diff can see every part: a header field (reported as byte 0), the
+     * last pair byte, the last ID. */
+    bu.root_ctx.axis[2].scale ^= 1;
+    assert_int_equal(cbvh_tree_diff(&td, &bu), 0);
+    bu.root_ctx.axis[2].scale ^= 1;
+    const size_t last = (size_t)bu.npairs * bu.pair_bytes - 1;
+    bu.pairs[last] ^= 0x80u;
+    assert_int_equal(cbvh_tree_diff(&td, &bu), (long)last);
+    bu.pairs[last] ^= 0x80u;
+    bu.ids[bu.nids - 1] ^= 1u;
+    assert_int_equal(cbvh_tree_diff(&td, &bu), (long)(last + 1 + 4 * ((size_t)bu.nids - 1)));
+    bu.ids[bu.nids - 1] ^= 1u;
+    assert_int_equal(cbvh_tree_diff(&td, &bu), -1);
     uint64_t hsum = 0;
     for (int i = 0; i < CBVH_BT_HIST; i++) hsum += stt.hist[i];
     assert_true(hsum == stt.reencodes);

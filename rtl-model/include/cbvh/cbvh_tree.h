@@ -105,8 +105,9 @@ int cbvh_tree_check(const cbvh_tree *t, const cbvh_bvh *b, char *err, size_t err
  * the root box is the float root box). -1 on a decode error. */
 double cbvh_tree_sah(const cbvh_tree *t);
 
-/* Index of the first differing byte of pairs/ids between two trees, or -1 if
- * bit-identical (same params, root, pairs and IDs). */
+/* Index of the first differing byte of pairs/ids between two trees (IDs
+ * counted after the pairs, 4 bytes each; 0 also when the parameters or the
+ * root differ), or -1 if bit-identical (same params, root, pairs and IDs). */
 long cbvh_tree_diff(const cbvh_tree *a, const cbvh_tree *b);
 
 #endif
