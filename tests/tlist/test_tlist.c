@@ -380,6 +380,23 @@ static void set_tri(cbvh_tri *t, float ax, float ay, float az, float bx, float b
     memcpy(t->v, v, sizeof v);
 }
 
+/* Five triangles no octant split separates: none is "big" (twice its half
+ * diagonal below the node's radius, 0.866), and every centroid lies in the
+ * lower octant of the box [0, 1]^3 (three slivers each reach 1 on one axis
+ * with their centroid exactly at 0.5, which is not above the centre).  The
+ * builder must make them one leaf, though there are more than leaf_max. */
+static void make_unsplittable(cbvh_scene *s) {
+    memset(s, 0, sizeof *s);
+    snprintf(s->name, sizeof s->name, "unsplittable");
+    s->ntris = 5;
+    s->tris = malloc(5 * sizeof *s->tris);
+    set_tri(&s->tris[0], 0.25f, 0, 0, 0.25f, 0.01f, 0, 1, 0, 0);
+    set_tri(&s->tris[1], 0, 0.25f, 0, 0.01f, 0.25f, 0, 0, 1, 0);
+    set_tri(&s->tris[2], 0, 0, 0.25f, 0.01f, 0, 0.25f, 0, 0, 1);
+    set_tri(&s->tris[3], 0, 0, 0, 0.01f, 0, 0, 0, 0.01f, 0);
+    set_tri(&s->tris[4], 0, 0, 0.01f, 0.01f, 0, 0.01f, 0, 0.01f, 0.01f);
+}
+
 /* Random soup: mostly small triangles, some huge (stay at high nodes), some
  * degenerate (collinear, a point), duplicates (same t: index rule). */
 static void make_soup(cbvh_scene *s, uint32_t n) {
@@ -545,6 +562,18 @@ int main(void) {
     }
     make_same_centroid(&s);
     run_scene(&s, n / 4);
+    cbvh_scene_free(&s);
+    make_unsplittable(&s);
+    {
+        cbvh_bsh h;
+        char err[256];
+        CHECK(cbvh_bsh_build(&s, NULL, &h, err, sizeof err) == 0 && cbvh_bsh_check(&h, &s, err, sizeof err) == 0,
+              "unsplittable: %s", err);
+        CHECK(h.nnodes == 1 && h.ntri[0] == 5 && h.nchild[0] == 0, "unsplittable: %u nodes, root holds %u triangles",
+              h.nnodes, h.ntri[0]);
+        cbvh_bsh_free(&h);
+    }
+    run_scene(&s, n / 8);
     cbvh_scene_free(&s);
     printf("%ld rays, %ld list traversals compared with the float BVH\n", rays_compared, traversals);
     printf("%s (%ld failures)\n", fails ? "FAILED" : "ok", fails);
