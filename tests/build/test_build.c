@@ -782,6 +782,61 @@ static void check_both(cbvh_bvh *b, int n, int min_scale, cbvh_encoding enc) {
     cbvh_tree_free(&bu);
 }
 
+/* SAH of degenerate roots: a scene on a line (root area 0) is costed by half
+ * perimeters, for the float BVH and its CBVH alike (decoded boxes enclose, so
+ * the CBVH's cost is not lower); a scene in one point costs 0.  A CBVH the
+ * cost walk cannot decode (root pair out of range; a reserved bit set) gives
+ * -1, not a number. */
+static void test_sah_degenerate(void **st) {
+    (void)st;
+    cbvh_scene s;
+    memset(&s, 0, sizeof s);
+    s.ntris = 16;
+    s.tris = calloc(16, sizeof *s.tris);
+    assert_non_null(s.tris);
+    for (int i = 0; i < 16; i++) /* slivers on the x axis: y = z = 0 */
+        for (int v = 0; v < 3; v++) s.tris[i].v[v][0] = (float)(i * 3 + v) * 0.5f;
+    cbvh_bvh b;
+    no_error(cbvh_build_sah(&s, 0, 1, &b, errbuf, sizeof errbuf));
+    no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+    double fb_sah = cbvh_bvh_sah(&b);
+    /* by half perimeters: the root (1) plus every other node's length share */
+    double want = 0.0, root_len = (double)b.nodes[b.root].hi[0] - b.nodes[b.root].lo[0];
+    for (uint32_t i = 0; i < b.nnodes; i++) {
+        const cbvh_bvh_node *n = &b.nodes[i];
+        want += (cbvh_bvh_is_leaf(n) ? (double)n->count : 1.0) * ((double)n->hi[0] - n->lo[0]) / root_len;
+    }
+    assert_float_equal(fb_sah, want, 1e-12);
+    assert_true(fb_sah > 1.0);
+    cbvh_compress_opts o = opts(8, -30, CBVH_ENC_MODULO, 1); /* N = 8: its pairs have reserved bits */
+    cbvh_tree t;
+    no_error(cbvh_compress_topdown(&b, &o, &t, errbuf, sizeof errbuf));
+    double tree_sah = cbvh_tree_sah(&t);
+    assert_true(tree_sah >= fb_sah && tree_sah < 2.0 * fb_sah);
+    const uint32_t rp = t.root_pair;
+    t.root_pair = t.npairs;
+    assert_true(cbvh_tree_sah(&t) == -1.0);
+    t.root_pair = rp;
+    const int nbits = cbvh_node_bits(8), ptr_end = 6 * 8 + 1 + cbvh_node_ptr_bits(8);
+    assert_true(ptr_end < nbits); /* a reserved bit exists */
+    uint8_t *pair = t.pairs + (size_t)rp * t.pair_bytes;
+    pair[ptr_end / 8] ^= (uint8_t)(1u << (ptr_end % 8));
+    assert_true(cbvh_tree_sah(&t) == -1.0);
+    pair[ptr_end / 8] ^= (uint8_t)(1u << (ptr_end % 8));
+    assert_true(cbvh_tree_sah(&t) == tree_sah);
+    cbvh_tree_free(&t);
+    cbvh_bvh_free(&b);
+    /* every vertex in one point: no length to cost by */
+    for (int i = 0; i < 16; i++) memset(&s.tris[i], 0, sizeof s.tris[i]);
+    no_error(cbvh_build_sah(&s, 0, 1, &b, errbuf, sizeof errbuf));
+    assert_true(cbvh_bvh_sah(&b) == 0.0);
+    no_error(cbvh_compress_topdown(&b, &o, &t, errbuf, sizeof errbuf));
+    assert_true(cbvh_tree_sah(&t) == 0.0);
+    cbvh_tree_free(&t);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
 /* A malformed float BVH (a box inverted, a NaN bound, a child far outside
  * its parent's grid) is refused by both compressors, each naming the pair
  * the encoder rejected with the unit's status, and leaves no tree behind. */
@@ -1216,6 +1271,7 @@ int main(void) {
         cmocka_unit_test(test_lbvh_morton_order),
         cmocka_unit_test(test_sah_valid_and_better),
         cmocka_unit_test(test_sah_cost_formula),
+        cmocka_unit_test(test_sah_degenerate),
         cmocka_unit_test(test_compress_bunny),
         cmocka_unit_test(test_compress_malformed),
         cmocka_unit_test(test_compress_hard_scenes),
