@@ -770,6 +770,12 @@ static void child_import(const char *path, int fd) {
         scene_arrays(&s, ptr, len);
         for (int a = 0; a < SCENE_ARRAYS && !bad; a++) bad = len[a] && write_full(fd, *ptr[a], len[a]);
     }
+#ifdef CBVH_COVERAGE_DUMP
+    {
+        extern void __gcov_dump(void); /* coverage builds only (gcc --coverage) */
+        __gcov_dump();
+    }
+#endif
     _exit(bad ? 1 : 0); /* no atexit handlers: they are the parent's */
 }
 
