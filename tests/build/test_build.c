@@ -1212,6 +1212,40 @@ static void test_backtrack_deep_chain(void **st) {
     cbvh_scene_free(&s);
 }
 
+/* The procedural twist as its header states: about the vertical axis through
+ * the box centre, by `amount` radians per scene height, so a vertex at the
+ * bottom stays, one at the top turns by `amount` (here a quarter turn: (x, z)
+ * -> (-z, x) about the centre), one halfway by half; y moves only with the
+ * wave, whose amplitude is `wave` times the height. */
+static void test_deform_twist(void **st) {
+    (void)st;
+    cbvh_scene s;
+    memset(&s, 0, sizeof s);
+    s.ntris = 1;
+    s.tris = calloc(1, sizeof *s.tris);
+    assert_non_null(s.tris);
+    const float v[3][3] = {{2, 1, 0}, {2, 5, 0}, {0, 3, 2}}; /* box [0,2]x[1,5]x[0,2], centre (1, _, 1) */
+    memcpy(s.tris[0].v, v, sizeof v);
+    const float q = 1.5707963f;
+    cbvh_tri out;
+    cbvh_scene_deform(&s, q, 0.0f, 0.0f, &out);
+    assert_float_equal(out.v[0][0], 2.0, 1e-6); /* bottom: unchanged */
+    assert_float_equal(out.v[0][2], 0.0, 1e-6);
+    assert_float_equal(out.v[1][0], 2.0, 1e-6); /* top: (1, -1) from the centre turns to (1, 1) */
+    assert_float_equal(out.v[1][2], 2.0, 1e-6);
+    const double c = cos(q / 2), sn = sin(q / 2); /* halfway: (-1, 1) turns by q/2 */
+    assert_float_equal(out.v[2][0], 1.0 + c * -1.0 - sn * 1.0, 1e-6);
+    assert_float_equal(out.v[2][2], 1.0 + sn * -1.0 + c * 1.0, 1e-6);
+    for (int k = 0; k < 3; k++) assert_float_equal(out.v[k][1], v[k][1], 0.0);
+    /* the wave alone: y + wave * h * sin(2 pi (x - x0) / w + t) */
+    cbvh_scene_deform(&s, 0.0f, 0.25f, 0.5f, &out);
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(out.v[k][0], v[k][0], 1e-6);
+        assert_float_equal(out.v[k][1], v[k][1] + 0.25 * 4.0 * sin(6.2831853 * v[k][0] / 2.0 + 0.5), 1e-5);
+    }
+    cbvh_scene_free(&s);
+}
+
 /* ---- refit ------------------------------------------------------------- */
 
 static void test_refit(void **st) {
@@ -1284,6 +1318,7 @@ int main(void) {
         cmocka_unit_test(test_naive_extremes_valid),
         cmocka_unit_test(test_modulo_fewer_backtracks),
         cmocka_unit_test(test_backtrack_deep_chain),
+        cmocka_unit_test(test_deform_twist),
         cmocka_unit_test(test_refit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
