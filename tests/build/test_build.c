@@ -826,6 +826,19 @@ static void test_sah_degenerate(void **st) {
     assert_true(cbvh_tree_sah(&t) == tree_sah);
     cbvh_tree_free(&t);
     cbvh_bvh_free(&b);
+    /* the smallest trees (one, two and three pairs): the cost walk's stack
+     * holds them (the sanitize preset sees any overrun) */
+    for (uint32_t nt = 2; nt <= 4; nt++) {
+        cbvh_scene small = s;
+        small.ntris = nt;
+        no_error(cbvh_build_sah(&small, 0, 1, &b, errbuf, sizeof errbuf));
+        no_error(cbvh_compress_topdown(&b, &o, &t, errbuf, sizeof errbuf));
+        assert_int_equal(t.npairs, nt - 1);
+        double c = cbvh_tree_sah(&t);
+        assert_true(c >= cbvh_bvh_sah(&b) && c < 2.0 * cbvh_bvh_sah(&b));
+        cbvh_tree_free(&t);
+        cbvh_bvh_free(&b);
+    }
     /* every vertex in one point: no length to cost by */
     for (int i = 0; i < 16; i++) memset(&s.tris[i], 0, sizeof s.tris[i]);
     no_error(cbvh_build_sah(&s, 0, 1, &b, errbuf, sizeof errbuf));

@@ -69,9 +69,29 @@ static void check_tight(const cbvh_bsh *h, const cbvh_scene *s) {
         }
         loose += all;
     }
+    /* Every centre is 0.5f*lo + 0.5f*hi of its subtree's tight box (tlist.md §3.1). */
+    uint32_t off_centre = 0;
+    for (uint32_t i = 0; i < h->nnodes; i++) {
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        int n = 0;
+        stack[n++] = i;
+        while (n) {
+            uint32_t k = stack[--n];
+            for (uint32_t j = 0; j < h->ntri[k]; j++)
+                for (int v = 0; v < 3; v++)
+                    for (int a = 0; a < 3; a++) {
+                        float x = s->tris[h->tri_ids[h->first_tri[k] + j]].v[v][a];
+                        lo[a] = x < lo[a] ? x : lo[a];
+                        hi[a] = x > hi[a] ? x : hi[a];
+                    }
+            for (uint32_t c = 0; c < h->nchild[k]; c++) stack[n++] = h->first_child[k] + c;
+        }
+        for (int a = 0; a < 3; a++) off_centre += h->sphere[i][a] != fb(0.5f * lo[a] + 0.5f * hi[a]);
+    }
     free(stack);
     CHECK(loose * 1000u <= nonzero, "%s: %u of %u radii are not tight (one ulp less still encloses)", s->name, loose,
           nonzero);
+    CHECK(off_centre == 0, "%s: %u sphere centre coordinates are not their box's centre", s->name, off_centre);
 }
 
 /* ---- list structure ----------------------------------------------------- */
