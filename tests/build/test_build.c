@@ -65,6 +65,14 @@ static void random_scene(cbvh_scene *s, uint32_t n, float spread, float size) {
     }
 }
 
+/* An empty scene of n zeroed triangles, to be filled by the test. */
+static void zero_scene(cbvh_scene *s, uint32_t n) {
+    memset(s, 0, sizeof *s);
+    s->ntris = n;
+    s->tris = calloc(n, sizeof *s->tris);
+    assert_non_null(s->tris);
+}
+
 static void no_error(int rc) {
     if (rc) fail_msg("%s", errbuf);
 }
@@ -627,10 +635,7 @@ static void test_lbvh_morton_order(void **st) {
     (void)st;
     enum { N = 3000 };
     cbvh_scene s;
-    memset(&s, 0, sizeof s);
-    s.ntris = N;
-    s.tris = calloc(N, sizeof *s.tris);
-    assert_non_null(s.tris);
+    zero_scene(&s, N);
     uint32_t *code = malloc(N * sizeof *code);
     assert_non_null(code);
     for (uint32_t i = 0; i < N; i++) {
@@ -790,10 +795,7 @@ static void check_both(cbvh_bvh *b, int n, int min_scale, cbvh_encoding enc) {
 static void test_sah_degenerate(void **st) {
     (void)st;
     cbvh_scene s;
-    memset(&s, 0, sizeof s);
-    s.ntris = 16;
-    s.tris = calloc(16, sizeof *s.tris);
-    assert_non_null(s.tris);
+    zero_scene(&s, 16);
     for (int i = 0; i < 16; i++) /* slivers on the x axis: y = z = 0 */
         for (int v = 0; v < 3; v++) s.tris[i].v[v][0] = (float)(i * 3 + v) * 0.5f;
     cbvh_bvh b;
@@ -1087,10 +1089,7 @@ static void test_naive_extremes_valid(void **st) {
     for (int i = 0; i < 120; i++) {
         cbvh_scene s;
         uint32_t n = 1 + rnd() % 160;
-        memset(&s, 0, sizeof s);
-        s.tris = malloc(n * sizeof *s.tris);
-        assert_non_null(s.tris);
-        s.ntris = n;
+        zero_scene(&s, n);
         for (uint32_t t = 0; t < n; t++) {
             float c[3];
             for (int a = 0; a < 3; a++) c[a] = rndf() - 0.5f;
@@ -1169,10 +1168,7 @@ static void test_backtrack_deep_chain(void **st) {
     (void)st;
     enum { D = 70, N = 6 };
     cbvh_scene s;
-    memset(&s, 0, sizeof s);
-    s.ntris = D + 2;
-    s.tris = calloc(s.ntris, sizeof *s.tris);
-    assert_non_null(s.tris);
+    zero_scene(&s, D + 2);
     for (uint32_t j = 0; j <= D + 1; j++) {
         int sc = -(int)j;
         s.tris[j].v[0][0] = s.tris[j].v[2][0] = j <= D ? ldexpf(-29.5f, sc) : 0.0f;
@@ -1233,10 +1229,7 @@ static void test_backtrack_deep_chain(void **st) {
 static void test_deform_twist(void **st) {
     (void)st;
     cbvh_scene s;
-    memset(&s, 0, sizeof s);
-    s.ntris = 1;
-    s.tris = calloc(1, sizeof *s.tris);
-    assert_non_null(s.tris);
+    zero_scene(&s, 1);
     const float v[3][3] = {{2, 1, 0}, {2, 5, 0}, {0, 3, 2}}; /* box [0,2]x[1,5]x[0,2], centre (1, _, 1) */
     memcpy(s.tris[0].v, v, sizeof v);
     const float q = 1.5707963f;
