@@ -12,12 +12,6 @@ static cbvh_f32 bits(float f) {
     return b;
 }
 
-/* The ray prepared for the unit's integer fast path, on the first fallback. */
-static const cbvh_rb_ray *prep(trav_state *ts) {
-    if (!ts->prep.ray) cbvh_rb_prepare(ts->ray, &ts->prep);
-    return &ts->prep;
-}
-
 /* The ray-box unit itself on node n's box with culling bound tmax: hit, and
  * t_near (for the boxes the binary64 filter leaves undecided). */
 static int unit_box(trav_state *ts, const cbvh_bvh_node *n, cbvh_f32 tmax, double *t_near) {
@@ -27,7 +21,7 @@ static int unit_box(trav_state *ts, const cbvh_bvh_node *n, cbvh_f32 tmax, doubl
         fhi[a] = bits(n->hi[a]);
     }
     cbvh_box_result r;
-    if (cbvh_ray_box_float_prep(prep(ts), tmax, ts->M, flo, fhi, &r) != 0 || !r.hit) return 0;
+    if (cbvh_ray_box_float_prep(trav_prep(ts), tmax, ts->M, flo, fhi, &r) != 0 || !r.hit) return 0;
     *t_near = cbvh_rbf_f32(r.t_near);
     return 1;
 }

@@ -10,8 +10,7 @@
  * that are exact in binary64, and the child context's bound clb = RD(u + r 2^e)
  * rounded directly from that exact plane. */
 #include "decode_fast.h"
-#include "ray_box_f64.h"
-#include "traverse_common.h"
+#include "traverse_cbvh_common.h"
 
 typedef struct {
     int leaf;
@@ -26,12 +25,6 @@ static void rel_coords(const cbvh_params *p, const cbvh_axis_ctx *ctx, const cbv
                        uint32_t *s) {
     cbvh_axis_store_codes(p, CBVH_ENC_RELATIVE, ctx, code, r, s);
     if (*s == 0) *s = 1u << p->quant_bits;
-}
-
-/* The ray prepared for the unit's integer fast path, on the first fallback. */
-static const cbvh_rb_ray *prep(trav_state *ts) {
-    if (!ts->prep.ray) cbvh_rb_prepare(ts->ray, &ts->prep);
-    return &ts->prep;
 }
 
 int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
@@ -50,18 +43,8 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
     cbvh_f32 cull = trav_box_tmax(&ts);
     double cull_d = cbvh_rbf_f32(cull);
     cbvh_box_result r;
-    ts.s.box_tests++;
-    double rlo[3], rhi[3], rtn;
-    int rhit;
-    for (int a = 0; a < 3; a++) {
-        rlo[a] = cbvh_rbf_f32(t->root_lo[a]);
-        rhi[a] = cbvh_rbf_f32(t->root_hi[a]);
-    }
-    if (!cbvh_rbf_box(&fp, cull_d, rlo, rhi, &rhit, &rtn)) {
-        rhit = cbvh_ray_box_float_prep(prep(&ts), cull, mant_bits, t->root_lo, t->root_hi, &r) == 0 && r.hit;
-        rtn = cbvh_rbf_f32(r.t_near);
-    }
-    if (rhit) {
+    double rtn;
+    if (trav_cbvh_root(&ts, &fp, t, cull, &rtn)) {
         stack[0].leaf = 0;
         stack[0].ctx_ok = fast_codec && cbvh_fast_node_ctx_ok(prm, &t->root_ctx);
         stack[0].ptr = t->root_pair;
@@ -74,16 +57,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
         entry *e = &stack[--sp];
         if (e->t_near > cull_d) continue;
         if (e->leaf) {
-            /* start the leaf's triangle loads together (memory latency) */
-            for (uint32_t i = e->ptr; i < t->nids; i++) {
-                __builtin_prefetch(&tris[t->ids[i] & ~CBVH_ID_LAST]);
-                if (t->ids[i] & CBVH_ID_LAST) break;
-            }
-            for (uint32_t i = e->ptr; i < t->nids && !ts.done; i++) {
-                trav_fetch(&ts, ts.ids_base + (uint64_t)i * 4u, 4u);
-                trav_triangle(&ts, t->ids[i] & ~CBVH_ID_LAST);
-                if (t->ids[i] & CBVH_ID_LAST) break;
-            }
+            trav_cbvh_leaf(&ts, t, e->ptr);
             if (ts.done) break;
             cull = trav_box_tmax(&ts);
             cull_d = cbvh_rbf_f32(cull);
@@ -128,7 +102,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                     g[a].r = fc[c].r[a];
                     g[a].s = fc[c].s[a];
                 }
-                h[c] = cbvh_ray_box_prep(prep(&ts), cull, mant_bits, g, &r) == 0 && r.hit;
+                h[c] = cbvh_ray_box_prep(trav_prep(&ts), cull, mant_bits, g, &r) == 0 && r.hit;
                 tn[c] = cbvh_rbf_f32(r.t_near);
             }
             if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
@@ -159,7 +133,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                     rel_coords(prm, &ctx.axis[a], &ch[c].axis[a], &g[a].r, &g[a].s);
                 }
                 ts.s.box_tests++;
-                h[c] = cbvh_ray_box_prep(prep(&ts), cull, mant_bits, g, &r) == 0 && r.hit;
+                h[c] = cbvh_ray_box_prep(trav_prep(&ts), cull, mant_bits, g, &r) == 0 && r.hit;
                 tn[c] = cbvh_rbf_f32(r.t_near);
             }
             if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;

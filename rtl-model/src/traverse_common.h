@@ -49,6 +49,13 @@ static inline int trav_begin(trav_state *ts, cbvh_trav_hit *hit, const cbvh_ray 
     return 0;
 }
 
+/* The ray prepared for the box unit's integer fast path, on the first
+ * fallback (most rays never need it). */
+static inline const cbvh_rb_ray *trav_prep(trav_state *ts) {
+    if (!ts->prep.ray) cbvh_rb_prepare(ts->ray, &ts->prep);
+    return &ts->prep;
+}
+
 static inline void trav_fetch(trav_state *ts, uint64_t addr, uint64_t size) {
     uint64_t n = cbvh_lines_touched(addr, size);
     ts->s.lines += n;

@@ -19,7 +19,10 @@
  *           soup, a cloth plane (degenerate z), the soup far from the origin;
  *   trees   LBVH and SAH float BVHs (box unit M = 24, 8, 3); top-down CBVHs
  *           at N = 3, 6, 10 modulo and N = 6 relative, a bottom-up N = 6;
- *           the QBVH (compressed stack); traversal lists (2 lists);
+ *           the QBVH (compressed stack); traversal lists (2 lists); each
+ *           CBVH also decoded once (docs/traversal.md §12: with the fast
+ *           paths off the decoded copy is not usable and its traversal is the
+ *           per-visit one, so the digest compares it with the exact paths);
  *   modes   closest and any hit.
  * usage: test_fast_invisible [--digest-out FILE] */
 #include <math.h>
@@ -31,6 +34,7 @@
 #include "cbvh/qbvh.h"
 #include "cbvh/tlist.h"
 #include "cbvh/traverse.h"
+#include "fast_paths.h"
 #include "test_util.h"
 
 #ifdef CBVH_SANITIZE
@@ -172,6 +176,7 @@ static void run_scene(int k) {
     enum { NT = 5 };
     static const int tn[NT] = {3, 6, 10, 6, 6};
     cbvh_tree t[NT];
+    cbvh_cbvh_decoded dt[NT];
     for (int j = 0; j < NT; j++) {
         cbvh_compress_opts o = {{tn[j], -30}, j == 3 ? CBVH_ENC_RELATIVE : CBVH_ENC_MODULO, 2, 0};
         int rc;
@@ -190,6 +195,10 @@ static void run_scene(int k) {
             exit(1);
         }
         for (size_t i = 0; i < (size_t)t[j].npairs * t[j].pair_bytes; i++) dg(t[j].pairs[i]); /* the trees too */
+        if (cbvh_cbvh_decode(&t[j], &dt[j], err, sizeof err) || dt[j].usable != CBVH_FAST_PATHS) {
+            fprintf(stderr, "FAIL %s: decoded CBVH %d: usable %d (%s)\n", scene_name[k], j, dt[j].usable, err);
+            exit(1);
+        }
     }
     cbvh_qbvh q;
     cbvh_bsh_params bp;
@@ -218,6 +227,8 @@ static void run_scene(int k) {
             for (int j = 0; j < NT; j++) {
                 cbvh_trav_stats st = {0};
                 record(cbvh_trace_cbvh(&t[j], s.tris, &r, mant[(i + j) % 3], md, &hit, &st), &hit, &st);
+                memset(&st, 0, sizeof st);
+                record(cbvh_trace_cbvh_decoded(&dt[j], s.tris, &r, mant[(i + j + 1) % 3], md, &hit, &st), &hit, &st);
             }
             cbvh_trav_stats st = {0};
             record(cbvh_trace_qbvh(&q, s.tris, &r, mant[i % 3], md, CBVH_QSTACK_COMPRESSED, &hit, &st), &hit, &st);
@@ -228,7 +239,10 @@ static void run_scene(int k) {
     cbvh_tlists_free(&L);
     cbvh_bsh_free(&h);
     cbvh_qbvh_free(&q);
-    for (int j = 0; j < NT; j++) cbvh_tree_free(&t[j]);
+    for (int j = 0; j < NT; j++) {
+        cbvh_cbvh_decoded_free(&dt[j]);
+        cbvh_tree_free(&t[j]);
+    }
     cbvh_bvh_free(&b[0]);
     cbvh_bvh_free(&b[1]);
     cbvh_scene_free(&s);

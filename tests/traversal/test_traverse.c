@@ -10,8 +10,15 @@
  *     real hit of the unit in [tmin, tmax]; its counters are a prefix of
  *     closest-hit's (it stops at its first accepted hit);
  *   - CBVH box tests >= float-BVH box tests (sums), counters plausible;
+ *   - the CBVH decoded once (cbvh_cbvh_decode, docs/traversal.md §12): every
+ *     record equals the node-pair unit's decode under the unit's contexts, and
+ *     its traversal gives the per-visit traversal's return value, hit and
+ *     counters on every ray; malformed trees (a cycle, a pointer out of range,
+ *     a pair the unit rejects, pairs of another width) are left to the
+ *     per-visit traversal (usable = 0) and keep its results;
  * scenes: scenes/bunny-small.obj, proc:far (far from the origin), proc:cloth
  * (a plane hit edge-on and at grazing angles). */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,6 +54,76 @@ static void add_stats(cbvh_trav_stats *sum, const cbvh_trav_stats *s) {
 static int any_is_prefix(const cbvh_trav_stats *any, const cbvh_trav_stats *closest) {
     return any->nodes <= closest->nodes && any->box_tests <= closest->box_tests &&
            any->tri_tests <= closest->tri_tests && any->lines <= closest->lines;
+}
+
+/* The decoded traversal equals the per-visit one: return value, hit and
+ * every counter. */
+static int decoded_same(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, const cbvh_ray *r, int M,
+                        cbvh_trav_mode mode) {
+    cbvh_trav_hit h1, h2;
+    cbvh_trav_stats s1 = {0}, s2 = {0};
+    int rc1 = cbvh_trace_cbvh(d->tree, tris, r, M, mode, &h1, &s1);
+    int rc2 = cbvh_trace_cbvh_decoded(d, tris, r, M, mode, &h2, &s2);
+    return rc1 == rc2 && !memcmp(&h1, &h2, sizeof h1) && !memcmp(&s1, &s2, sizeof s1);
+}
+
+/* a + b is exact in binary64 (Knuth's 2Sum: the rounding error is zero). */
+static int sum_exact(double a, double b) {
+    double x = a + b, bv = x - a;
+    double av = x - bv;
+    return isfinite(x) && (a - av) + (b - bv) == 0;
+}
+
+/* Every reachable record against the node-pair unit (cbvh_nodepair_decode)
+ * under contexts derived by the unit (cbvh_axis_child_ctx), independently of
+ * the fast decode the records come from.  Returns the number of differences;
+ * *exact counts the pairs whose planes are exact in binary64. */
+static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact) {
+    const cbvh_tree *t = d->tree;
+    const cbvh_params *p = &t->params;
+    uint32_t *sp_pair = malloc(((size_t)t->npairs + 2) * sizeof *sp_pair);
+    cbvh_node_ctx *sp_ctx = malloc(((size_t)t->npairs + 2) * sizeof *sp_ctx);
+    long bad = 0;
+    int sp = 0;
+    sp_pair[sp] = t->root_pair;
+    sp_ctx[sp++] = t->root_ctx;
+    while (sp > 0) {
+        uint32_t i = sp_pair[--sp];
+        cbvh_node_ctx ctx = sp_ctx[sp];
+        cbvh_child_out ch[2];
+        if (cbvh_nodepair_decode(p, t->enc, &ctx, t->pairs + (size_t)i * t->pair_bytes, ch)) {
+            bad++;
+            continue;
+        }
+        const cbvh_cbvh_dnode *rec = &d->nodes[i];
+        *exact += (rec->flags & CBVH_DEC_EXACT) != 0;
+        for (int a = 0; a < 3; a++) bad += rec->clb[a] != ctx.axis[a].clb || rec->scale[a] != ctx.axis[a].scale;
+        for (int c = 0; c < 2; c++) {
+            bad += ((rec->flags >> c) & 1) != (uint32_t)ch[c].leaf ||
+                   ((rec->flags >> (2 + c)) & 1) != (uint32_t)ch[c].empty;
+            if (ch[c].empty) continue;
+            bad += rec->child[c] != ch[c].ptr;
+            for (int a = 0; a < 3; a++) {
+                uint32_t r, s;
+                cbvh_axis_store_codes(p, CBVH_ENC_RELATIVE, &ctx.axis[a], &ch[c].axis[a], &r, &s);
+                if (s == 0) s = 1u << p->quant_bits;
+                bad += d->rel[i].r[c][a] != r || d->rel[i].s[c][a] != s;
+                if (rec->flags & CBVH_DEC_EXACT) { /* the filter's premise: u + r 2^e, u + s 2^e exact */
+                    double u = cbvh_float_of(ctx.axis[a].clb), lo = ldexp((double)r, ctx.axis[a].scale),
+                           hi = ldexp((double)s, ctx.axis[a].scale);
+                    bad += !sum_exact(u, lo) || !sum_exact(u, hi) || rec->lo[a][c] != u + lo ||
+                           rec->hi[a][c] != u + hi;
+                }
+            }
+            if (ch[c].leaf) continue;
+            sp_pair[sp] = ch[c].ptr;
+            for (int a = 0; a < 3; a++) sp_ctx[sp].axis[a] = cbvh_axis_child_ctx(&ctx.axis[a], &ch[c].axis[a]);
+            sp++;
+        }
+    }
+    free(sp_pair);
+    free(sp_ctx);
+    return bad;
 }
 
 static void run_scene(const char *spec) {
@@ -135,7 +212,24 @@ static void run_scene(const char *spec) {
             continue;
         }
         cbvh_trav_stats cs = {0}, ca = {0};
-        long mismatches = 0;
+        long mismatches = 0, exact = 0, dec_bad = 0;
+        cbvh_cbvh_decoded dt;
+        if (cbvh_cbvh_decode(&t, &dt, err, sizeof err) || !dt.usable) {
+            fprintf(stderr, "FAIL decode %s N=%d: not usable (%s)\n", spec, cfg[c].N, err);
+            failures++;
+        } else {
+            dec_bad = decoded_vs_unit(&dt, &exact);
+            for (int i = 0; i < RAYS; i++)
+                for (int mode = 0; mode < 2; mode++)
+                    dec_bad += !decoded_same(&dt, s.tris, &rays[i], cfg[c].M, (cbvh_trav_mode)mode);
+        }
+        /* nearly every pair of these scenes has binary64-exact planes (the filter's case) */
+        if (dec_bad || exact * 10 < (long)t.npairs * 9) {
+            fprintf(stderr, "FAIL decoded CBVH %s N=%d M=%d: %ld differences, %ld of %u pairs exact\n", spec,
+                    cfg[c].N, cfg[c].M, dec_bad, exact, t.npairs);
+            failures++;
+        }
+        cbvh_cbvh_decoded_free(&dt);
         for (int i = 0; i < RAYS; i++) {
             cbvh_trav_hit h, any;
             cbvh_trav_stats c1 = {0}, a1 = {0};
@@ -161,6 +255,8 @@ static void run_scene(const char *spec) {
                (double)cs.box_tests / RAYS, (double)cs.box_tests / (double)fs.box_tests, (double)cs.tri_tests / RAYS,
                (double)cs.tri_tests / (double)fs.tri_tests, (double)cs.bytes / RAYS,
                (double)cs.bytes / (double)fs.bytes, cs.max_stack, (double)ca.box_tests / RAYS, mismatches);
+        printf("%-22s N=%-2d M=%-2d %-8s decoded once: %u pairs, %ld exact in binary64, %d x 2 rays identical\n",
+               spec, cfg[c].N, cfg[c].M, cbvh_encoding_name(cfg[c].enc), t.npairs, exact, RAYS);
         if (cs.box_tests < fs.box_tests) {
             fprintf(stderr, "FAIL %s N=%d: CBVH box tests %llu < float %llu\n", spec, cfg[c].N,
                     (unsigned long long)cs.box_tests, (unsigned long long)fs.box_tests);
@@ -205,6 +301,11 @@ static void bad_rays(void) {
                 failures++;
             cbvh_fbvh_free(&fb);
             if (cbvh_trace_cbvh(&t, s.tris, &bad[i], 24, CBVH_TRAV_CLOSEST, &h, &st) != -1 || h.hit) failures++;
+            cbvh_cbvh_decoded dt;
+            if (cbvh_cbvh_decode(&t, &dt, err, sizeof err) || !dt.usable ||
+                cbvh_trace_cbvh_decoded(&dt, s.tris, &bad[i], 24, CBVH_TRAV_CLOSEST, &h, &st) != -1 || h.hit)
+                failures++;
+            cbvh_cbvh_decoded_free(&dt);
             if (st.box_tests || st.tri_tests) failures++;
         }
         cbvh_tree_free(&t);
@@ -314,6 +415,56 @@ static void cyclic_cbvh(void) {
                     unit ? "unit" : "fast", rc, h.hit);
             failures++;
         }
+        /* not a tree: the decoded copy is not usable and tracing keeps the -1 */
+        cbvh_cbvh_decoded dt;
+        char err[256] = "";
+        if (cbvh_cbvh_decode(&t, &dt, err, sizeof err) || dt.usable || dt.nodes ||
+            !decoded_same(&dt, &tri, &r, 24, CBVH_TRAV_CLOSEST)) {
+            fprintf(stderr, "FAIL cyclic CBVH (%s decode): decoded copy usable %d (%s)\n", unit ? "unit" : "fast",
+                    dt.usable, err);
+            failures++;
+        }
+        cbvh_cbvh_decoded_free(&dt);
+    }
+}
+
+/* Trees the decoded copy must leave to the per-visit traversal (usable = 0),
+ * which then gives its own result (here -1: the ray reaches the bad part):
+ * an inner child pointing past the last pair, an inverted child box the
+ * node-pair unit rejects, a root context the unit rejects, no pairs at all,
+ * pairs padded to another width (the fast decode's case: the unit decodes). */
+static void decoded_malformed(void) {
+    static const char *const what[5] = {"pointer out of range", "inverted child", "bad root context", "no pairs",
+                                        "padded pairs"};
+    cbvh_tri tri = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}; /* floats, not bit patterns */
+    cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(2)}, {0, 0, fb(-1)}, 0, CBVH_F32_POS_INF};
+    for (int k = 0; k < 5; k++) {
+        cbvh_tree t;
+        uint8_t pair[32];
+        uint32_t id = CBVH_ID_LAST;
+        if (one_pair_cbvh(&t, pair, k == 4, k == 4 ? 0 : 5, k == 4)) {
+            failures++;
+            continue;
+        }
+        t.ids = &id;
+        t.nids = 1;
+        if (k == 1) { /* child 0, x: codes r = 7, s = 3 (0 and 2^N before) */
+            pair[0] = 7u | 3u << 6;
+            pair[1] &= (uint8_t)~0x0Fu;
+        }
+        if (k == 2) t.root_ctx.axis[1].lb_mod = 64;
+        if (k == 3) t.npairs = 0;
+        cbvh_cbvh_decoded dt;
+        char err[256] = "";
+        cbvh_trav_hit h;
+        cbvh_trav_stats st = {0};
+        int rc = cbvh_trace_cbvh(&t, &tri, &r, 24, CBVH_TRAV_CLOSEST, &h, &st);
+        if (cbvh_cbvh_decode(&t, &dt, err, sizeof err) || dt.usable ||
+            !decoded_same(&dt, &tri, &r, 24, CBVH_TRAV_CLOSEST) || rc != (k == 4 ? 0 : -1)) {
+            fprintf(stderr, "FAIL decoded CBVH, %s: usable %d, per-visit rc %d (%s)\n", what[k], dt.usable, rc, err);
+            failures++;
+        }
+        cbvh_cbvh_decoded_free(&dt);
     }
 }
 
@@ -368,6 +519,7 @@ int main(void) {
     bad_rays();
     layout_cases();
     cyclic_cbvh();
+    decoded_malformed();
     memory_map();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
     run_scene("proc:far:8");

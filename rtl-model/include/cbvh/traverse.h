@@ -91,6 +91,54 @@ void cbvh_fbvh_free(cbvh_fbvh *f);
 int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
                          cbvh_trav_hit *hit, cbvh_trav_stats *st);
 
+/* The CBVH decoded once (docs/traversal.md §12): per node pair, what
+ * cbvh_trace_cbvh derives from it on every visit — both children's planes
+ * u + r 2^e, u + s 2^e in binary64 when every one is exact there, their
+ * pointers and leaf and empty bits, the pair's context (u and e of each axis)
+ * and, apart, the relative coordinates r, s for the box unit's fallback.  The
+ * records come from the same decode (decode_fast.h) and the same context
+ * derivation as the traversal's, so tracing with them gives
+ * cbvh_trace_cbvh's outputs and counters bit for bit; only the decode's
+ * repetition is gone.  128 + 24 bytes per pair (the CBVH itself: 16 or 24). */
+#define CBVH_DEC_LEAF0 1u  /* flags: child 0 a leaf, ... */
+#define CBVH_DEC_EMPTY0 4u /* ... child 0 empty (child 1: the bit doubled) */
+#define CBVH_DEC_EXACT 16u /* every plane exact in binary64: lo, hi valid, the binary64 box filter applies */
+typedef struct {
+    double lo[3][2], hi[3][2]; /* [axis][child]; an empty child's box is a dummy; 0 unless EXACT */
+    uint32_t child[2];         /* pointer: a pair index, or a leaf's first ID */
+    cbvh_f32 clb[3];           /* u: the context's lower bound per axis */
+    int8_t scale[3];           /* e: the context's scale per axis, in [-126, 126] */
+    uint8_t flags;
+    uint8_t pad[8];
+} cbvh_cbvh_dnode;
+
+typedef struct {
+    uint16_t r[2][3], s[2][3]; /* [child][axis]; s in [1, 2^N]; an empty child: 0, 1 */
+} cbvh_cbvh_drel;
+
+typedef struct {
+    const cbvh_tree *tree;  /* not owned; must outlive the decoded copy */
+    int usable;             /* 0: every pair is decoded on its visit (see cbvh_cbvh_decode) */
+    cbvh_cbvh_dnode *nodes; /* npairs records, 64-byte aligned, indexed by pair */
+    cbvh_cbvh_drel *rel;    /* npairs, indexed by pair */
+} cbvh_cbvh_decoded;
+
+/* Decode every pair reachable from the root.  0, or -1 with a one-line reason
+ * (out of memory).  usable = 0 (and tracing then decodes per visit, exactly as
+ * cbvh_trace_cbvh) when the fast paths are compiled out, or when the tree is
+ * one the traversal's fast decode does not take (parameters or a context it
+ * does not check, a pair the node-pair unit would reject, a pointer out of
+ * range, a pair reached twice): those trees keep every error and counter of
+ * cbvh_trace_cbvh. */
+int cbvh_cbvh_decode(const cbvh_tree *t, cbvh_cbvh_decoded *out, char *err, size_t errlen);
+void cbvh_cbvh_decoded_free(cbvh_cbvh_decoded *d);
+
+/* cbvh_trace_cbvh(d->tree, ...) with the pairs' decodes taken from d: the same
+ * return value, hit and counters (lines and bytes of the CBVH's own memory
+ * image), bit for bit. */
+int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
+                            cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st);
+
 /* Lines covered by [addr, addr + size). */
 static inline uint64_t cbvh_lines_touched(uint64_t addr, uint64_t size) {
     return size ? (addr + size - 1) / CBVH_LINE_BYTES - addr / CBVH_LINE_BYTES + 1 : 0;
