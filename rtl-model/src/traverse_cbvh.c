@@ -57,10 +57,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
         entry *e = &stack[--sp];
         if (e->t_near > cull_d) continue;
         if (e->leaf) {
-            trav_cbvh_leaf(&ts, t, e->ptr);
-            if (ts.done) break;
-            cull = trav_box_tmax(&ts);
-            cull_d = cbvh_rbf_f32(cull);
+            if (trav_cbvh_leaf(&ts, t, e->ptr, &cull, &cull_d)) break;
             continue;
         }
         /* a tree visits each pair at most once per ray: more is a pointer cycle */

@@ -26,8 +26,9 @@ static inline int trav_cbvh_root(trav_state *ts, const cbvh_rbf_ray *fp, const c
 }
 
 /* A leaf's triangles from ID index `first` to the one marked last (their
- * loads started together: memory latency). */
-static inline void trav_cbvh_leaf(trav_state *ts, const cbvh_tree *t, uint32_t first) {
+ * loads started together: memory latency); then the culling bound, which
+ * only an accepted triangle changes.  1 when an any-hit traversal is done. */
+static inline int trav_cbvh_leaf(trav_state *ts, const cbvh_tree *t, uint32_t first, cbvh_f32 *cull, double *cull_d) {
     for (uint32_t i = first; i < t->nids; i++) {
         __builtin_prefetch(&ts->tris[t->ids[i] & ~CBVH_ID_LAST]);
         if (t->ids[i] & CBVH_ID_LAST) break;
@@ -37,6 +38,9 @@ static inline void trav_cbvh_leaf(trav_state *ts, const cbvh_tree *t, uint32_t f
         trav_triangle(ts, t->ids[i] & ~CBVH_ID_LAST);
         if (t->ids[i] & CBVH_ID_LAST) break;
     }
+    *cull = trav_box_tmax(ts);
+    *cull_d = cbvh_rbf_f32(*cull);
+    return ts->done;
 }
 
 #endif

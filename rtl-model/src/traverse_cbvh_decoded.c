@@ -144,10 +144,7 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
         entry *e = &stack[--sp];
         if (e->t_near > cull_d) continue;
         if (e->leaf) {
-            trav_cbvh_leaf(&ts, t, e->ptr);
-            if (ts.done) break;
-            cull = trav_box_tmax(&ts);
-            cull_d = cbvh_rbf_f32(cull);
+            if (trav_cbvh_leaf(&ts, t, e->ptr, &cull, &cull_d)) break;
             continue;
         }
         uint32_t p = e->ptr;
