@@ -23,7 +23,8 @@ static double half_area(const cbvh_bvh_node *n) {
 }
 
 /* Up to 4 binary nodes under inner node `src`: open the inner child of largest
- * area until there are 4, keeping left-to-right order. */
+ * area (the leftmost of equal ones: strict >) until there are 4, keeping
+ * left-to-right order. */
 static int gather(const cbvh_bvh *b, uint32_t src, uint32_t out[4]) {
     int n = 2;
     out[0] = b->nodes[src].child[0];

@@ -322,6 +322,55 @@ static void memory_map(void) {
     fails += (int)bad;
 }
 
+/* The collapse's order and its tie rule (qbvh.h): a node opens the inner
+ * child of largest area, the leftmost of equal ones, and keeps the binary
+ * left-to-right order.  Every box here is [0, 1]^3, so every choice is a tie:
+ *   root -> A, B;  A -> a0, leaf p4;  B -> b0, leaf p5;
+ *   a0 -> leaves p0, p1;  b0 -> leaves p2, p3.
+ * Leftmost first: the root opens A, then a0: children p0, p1, p4, B, and B's
+ * children p2, p3, p5.  (Rightmost first would give A, p2, p3, p5.) */
+static void collapse_ties(void) {
+    cbvh_bvh_node n[11];
+    memset(n, 0, sizeof n);
+    static const uint32_t kids[11][2] = {{1, 2}, {3, 4}, {5, 6}, {7, 8}, {0, 0}, {9, 10}};
+    static const uint32_t prim_of[11] = {0, 0, 0, 0, 4, 0, 5, 0, 1, 2, 3};
+    uint32_t prims[6] = {0, 1, 2, 3, 4, 5};
+    for (int i = 0; i < 11; i++) {
+        for (int a = 0; a < 3; a++) n[i].hi[a] = 1.0f;
+        int leaf = i == 4 || i == 6 || i >= 7;
+        if (leaf) {
+            n[i].first = prim_of[i];
+            n[i].count = 1;
+        } else {
+            n[i].child[0] = kids[i][0];
+            n[i].child[1] = kids[i][1];
+        }
+    }
+    cbvh_bvh b = {n, 11, 0, prims, 6};
+    cbvh_qbvh q = {0};
+    char err[256] = "";
+    CHECK(cbvh_qbvh_from_bvh(&b, &q, err, sizeof err) == 0, "collapse of the tie tree: %s", err);
+    if (!q.nnodes) return;
+    /* a child's primitive (a leaf) or -1 (inner) */
+    uint32_t f = q.first[0];
+    CHECK(q.count[0] == 4 && q.nnodes == 8, "root has %u children, %u nodes; want 4, 8", q.count[0], q.nnodes);
+    static const int want_root[4] = {0, 1, 4, -1}, want_b[3] = {2, 3, 5};
+    for (int c = 0; c < 4 && q.count[0] == 4; c++) {
+        uint32_t i = f + (uint32_t)c;
+        int got = (q.count[i] & CBVH_QBVH_LEAF) ? (int)q.prims[q.first[i]] : -1;
+        CHECK(got == want_root[c], "root child %d: primitive %d, want %d", c, got, want_root[c]);
+    }
+    uint32_t bi = f + 3;
+    CHECK(q.nnodes == 8 && !(q.count[bi] & CBVH_QBVH_LEAF) && q.count[bi] == 3, "B: count %08X, want 3",
+          q.nnodes == 8 ? q.count[bi] : 0);
+    for (int c = 0; c < 3 && q.nnodes == 8 && q.count[bi] == 3; c++) {
+        uint32_t i = q.first[bi] + (uint32_t)c;
+        int got = (q.count[i] & CBVH_QBVH_LEAF) ? (int)q.prims[q.first[i]] : -1;
+        CHECK(got == want_b[c], "B child %d: primitive %d, want %d", c, got, want_b[c]);
+    }
+    cbvh_qbvh_free(&q);
+}
+
 int main(void) {
 #ifdef CBVH_SANITIZE
     int n = 3000;
@@ -333,6 +382,7 @@ int main(void) {
     run_scene("proc:far", n / 2);
     past_limit();
     cyclic();
+    collapse_ties();
     memory_map();
     /* The compressed and wide stacks overflow past CBVH_TRAV_STACK inner
      * nodes; the plain stack with two entries per node at 129. */

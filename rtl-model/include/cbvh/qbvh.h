@@ -65,8 +65,9 @@ void cbvh_qbvh_free(cbvh_qbvh *q);
 
 /* Collapse a binary BVH (any builder; the paper uses cbvh_build_sah) into a
  * QBVH: each node takes up to 4 children by repeatedly opening the inner
- * child of largest surface area; children keep the binary left-to-right
- * order and are laid out breadth-first.  0, or -1 + one-line reason. */
+ * child of largest surface area (of equal areas, the leftmost); children
+ * keep the binary left-to-right order and are laid out breadth-first.  0, or
+ * -1 + one-line reason. */
 int cbvh_qbvh_from_bvh(const cbvh_bvh *b, cbvh_qbvh *out, char *err, size_t errlen);
 
 /* Structure check: every node reachable once, counts 2..4, every primitive in
