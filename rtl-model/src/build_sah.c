@@ -21,6 +21,30 @@ static void box_grow(box *b, const box *o) {
         if (o->hi[a] > b->hi[a]) b->hi[a] = o->hi[a];
     }
 }
+/* Centroid binning along one axis: bin = (c - lo) * bins / extent,
+ * truncated and clamped to [0, bins - 1].  In binary32, as the builder has
+ * always binned, unless the scale bins / extent is not a positive finite
+ * binary32: the extent overflows (centroids near +-FLT_MAX: the scale is 0)
+ * or is so small that the scale overflows (subnormal extents).  Those axes
+ * are binned in binary64, where every operand is finite; in binary32 the
+ * product would be NaN or Inf, whose conversion to int is undefined. */
+typedef struct {
+    float lo, sc;
+    double dlo, dsc;
+    int wide; /* binary64 */
+} binner;
+
+static binner binner_make(float lo, float hi, int bins) {
+    binner b = {lo, (float)bins / (hi - lo), lo, (double)bins / ((double)hi - (double)lo), 0};
+    b.wide = !(b.sc > 0.0f && b.sc < INFINITY);
+    return b;
+}
+
+static int bin_of(const binner *b, float c, int bins) {
+    double x = b->wide ? ((double)c - b->dlo) * b->dsc : (double)((c - b->lo) * b->sc);
+    return x >= (double)bins ? bins - 1 : x >= 1.0 ? (int)x : 0;
+}
+
 static double box_area(const box *b) {
     if (b->lo[0] > b->hi[0]) return 0.0;
     double dx = (double)b->hi[0] - b->lo[0], dy = (double)b->hi[1] - b->lo[1], dz = (double)b->hi[2] - b->lo[2];
@@ -79,10 +103,9 @@ int cbvh_build_sah(const cbvh_scene *s, int bins, int max_leaf, cbvh_bvh *out, c
                 box bb[64];
                 uint32_t bc[64] = {0};
                 for (int k = 0; k < bins; k++) box_empty(&bb[k]);
-                float sc = (float)bins / ext;
+                binner bn = binner_make(cb.lo[a], cb.hi[a], bins);
                 for (uint32_t i = t.begin; i < t.end; i++) {
-                    int k = (int)((cen[prims[i]][a] - cb.lo[a]) * sc);
-                    k = k < 0 ? 0 : k >= bins ? bins - 1 : k;
+                    int k = bin_of(&bn, cen[prims[i]][a], bins);
                     bc[k]++;
                     box_grow(&bb[k], &tb[prims[i]]);
                 }
@@ -116,11 +139,10 @@ int cbvh_build_sah(const cbvh_scene *s, int bins, int max_leaf, cbvh_bvh *out, c
         if (!make_leaf) {
             if (best_axis >= 0) {
                 /* Stable partition by bin. */
-                float ext = cb.hi[best_axis] - cb.lo[best_axis], sc = (float)bins / ext;
+                binner bn = binner_make(cb.lo[best_axis], cb.hi[best_axis], bins);
                 uint32_t l = t.begin, r = 0;
                 for (uint32_t i = t.begin; i < t.end; i++) {
-                    int k = (int)((cen[prims[i]][best_axis] - cb.lo[best_axis]) * sc);
-                    k = k < 0 ? 0 : k >= bins ? bins - 1 : k;
+                    int k = bin_of(&bn, cen[prims[i]][best_axis], bins);
                     if (k <= best_bin)
                         prims[l++] = prims[i];
                     else

@@ -719,6 +719,37 @@ static void test_sah_valid_and_better(void **st) {
     cbvh_scene_free(&s);
 }
 
+/* Centroid extents binary32 cannot scale (build_sah.c, binner): x
+ * centroids at -+3e38, whose extent overflows (bins / extent = 0), and at 0
+ * and 2^-146, whose scale bins / extent overflows.  The builder once
+ * converted the NaN or Inf products to int (undefined; found by
+ * fuzz_cbvh_traverse, caught by the sanitize preset's float-cast-overflow).
+ * Now those axes are binned in binary64: the tree is valid and the root
+ * separates the two sides. */
+static void test_sah_extreme_extents(void **st) {
+    (void)st;
+    const float side[2][2] = {{-3e38f, 3e38f}, {0.0f, 1.12103877e-44f}}; /* 8 * 2^-149 */
+    for (int k = 0; k < 2; k++) {
+        cbvh_scene s;
+        zero_scene(&s, 16);
+        for (uint32_t i = 0; i < 16; i++) /* segments along z, x on one side: only x splits */
+            for (int v = 0; v < 3; v++) {
+                s.tris[i].v[v][0] = side[k][i & 1];
+                s.tris[i].v[v][2] = (float)v;
+            }
+        cbvh_bvh b;
+        no_error(cbvh_build_sah(&s, 16, 1, &b, errbuf, sizeof errbuf));
+        no_error(cbvh_bvh_check(&b, &s, errbuf, sizeof errbuf));
+        /* the centroids differ in x alone: the root splits there */
+        const cbvh_bvh_node *r = &b.nodes[b.root];
+        assert_false(cbvh_bvh_is_leaf(r));
+        const cbvh_bvh_node *c0 = &b.nodes[r->child[0]], *c1 = &b.nodes[r->child[1]];
+        assert_true(c0->hi[0] == side[k][0] && c1->lo[0] == side[k][1]);
+        cbvh_bvh_free(&b);
+        cbvh_scene_free(&s);
+    }
+}
+
 static void test_sah_cost_formula(void **st) {
     (void)st;
     /* Two unit-cube-ish leaves side by side: root [0,2]x[0,1]x[0,1] area 10,
@@ -1312,6 +1343,7 @@ int main(void) {
         cmocka_unit_test(test_sah_valid_and_better),
         cmocka_unit_test(test_sah_cost_formula),
         cmocka_unit_test(test_sah_degenerate),
+        cmocka_unit_test(test_sah_extreme_extents),
         cmocka_unit_test(test_compress_bunny),
         cmocka_unit_test(test_compress_malformed),
         cmocka_unit_test(test_compress_hard_scenes),
