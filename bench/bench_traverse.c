@@ -52,7 +52,7 @@ typedef struct {
 /* tracer: 0 float BVH through the units, 1 CBVH, 2 float BVH plain float,
  * 3 CBVH decoded once */
 static result run_ours(int cbvh, const cbvh_bvh *b, const cbvh_fbvh *fb, const cbvh_tree *t,
-                       const cbvh_cbvh_decoded *dt_, const cbvh_tri *tris, const cbvh_ray *rays, int n,
+                       const cbvh_cbvh_decoded *dec, const cbvh_tri *tris, const cbvh_ray *rays, int n,
                        cbvh_trav_mode mode, int reps, cbvh_trav_stats *st) {
     result res = {0, 0};
     double best = 1e30;
@@ -63,7 +63,7 @@ static result run_ours(int cbvh, const cbvh_bvh *b, const cbvh_fbvh *fb, const c
         for (int i = 0; i < n; i++) {
             cbvh_trav_hit h;
             int rc = cbvh == 1   ? cbvh_trace_cbvh(t, tris, &rays[i], 24, mode, &h, &s)
-                     : cbvh == 3 ? cbvh_trace_cbvh_decoded(dt_, tris, &rays[i], 24, mode, &h, &s)
+                     : cbvh == 3 ? cbvh_trace_cbvh_decoded(dec, tris, &rays[i], 24, mode, &h, &s)
                      : cbvh == 2 ? cbvh_trace_bvh_float(fb, tris, &rays[i], mode, &h, &s)
                                  : cbvh_trace_bvh(b, tris, &rays[i], 24, mode, &h, &s);
             if (rc) die("trace", "ray rejected");
@@ -138,8 +138,8 @@ int main(int argc, char **argv) {
             const cbvh_ray *rr = rays + (half ? nrays / 2 : 0);
             int n = half ? nrays - nrays / 2 : nrays / 2;
             for (int mode = 0; mode < 2; mode++) {
-                /* repetitions interleave the three tracers so that load changes on
-                 * the shared machine hit all of them alike; best time of each */
+                /* repetitions interleave the tracers so that load changes on the
+                 * shared machine hit all of them alike; best time of each */
                 cbvh_trav_stats sb = {0}, sc_ = {0}, sf = {0}, sd = {0};
                 result rb = {0, 0}, rc = {0, 0}, re = {0, 0}, rf = {0, 0}, rd = {0, 0};
                 cbvh_trav_mode md = (cbvh_trav_mode)mode;

@@ -50,22 +50,22 @@ static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx,
     for (int c = 0; c < 2; c++) {
         rec->child[c] = fc[c].ptr;
         rec->flags |= (fc[c].leaf ? CBVH_DEC_LEAF0 << c : 0) | (fc[c].empty ? CBVH_DEC_EMPTY0 << c : 0);
+        double lo[3]; /* the traversal's planes, formed the same way */
         for (int a = 0; a < 3; a++) { /* an empty slot gets the traversal's dummy box [u, u + 2^e] */
             rel->r[c][a] = (uint16_t)(fc[c].empty ? 0 : fc[c].r[a]);
             rel->s[c][a] = (uint16_t)(fc[c].empty ? 1 : fc[c].s[a]);
-            if (exact) { /* the traversal's planes, formed the same way */
-                rec->lo[a][c] = ax[a].u + (double)rel->r[c][a] * ax[a].step;
+            lo[a] = ax[a].u + (double)rel->r[c][a] * ax[a].step;
+            if (exact) {
+                rec->lo[a][c] = lo[a];
                 rec->hi[a][c] = ax[a].u + (double)rel->s[c][a] * ax[a].step;
             }
         }
         if (fc[c].empty || fc[c].leaf) continue;
         walk_entry *w = &push[(*npush)++];
         w->pair = fc[c].ptr;
-        for (int a = 0; a < 3; a++) {
-            double lo = ax[a].u + (double)fc[c].r[a] * ax[a].step; /* the traversal's lower plane */
-            cbvh_fast_child_ctx(prm, t->enc, &ctx->axis[a], ppm[a], &fc[c], a, ax[a].exact ? &lo : NULL,
+        for (int a = 0; a < 3; a++)
+            cbvh_fast_child_ctx(prm, t->enc, &ctx->axis[a], ppm[a], &fc[c], a, ax[a].exact ? &lo[a] : NULL,
                                 &w->ctx.axis[a]);
-        }
     }
     return 1;
 }
