@@ -7,8 +7,9 @@
  * pair, and up to eight rays.  Properties, each an abort:
  *   - neither traversal crashes or reads out of bounds (ASan), whatever the
  *     tree (cycles, pointers out of range, pairs the unit rejects);
- *   - the CBVH decoded once (cbvh_trace_cbvh_decoded, docs/traversal.md §12)
- *     gives the per-visit traversal's return value, hit and counters;
+ *   - the CBVH decoded once (cbvh_trace_cbvh_decoded, docs/traversal.md §12),
+ *     with or without its leaf copy, gives the per-visit traversal's return
+ *     value, hit and counters;
  *   - on an uncorrupted tree both succeed and hit exactly what brute force
  *     over the ray-triangle unit hits (closest: the same triangle and t). */
 #include <stdint.h>
@@ -105,6 +106,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cbvh_cbvh_decoded d;
     if (cbvh_cbvh_decode(&t, &d, err, sizeof err)) abort(); /* only out of memory, not here */
     if (!corrupt && !d.usable) abort(); /* a tree the compressors emit is one the fast decode takes */
+    if ((mode & 64) && cbvh_cbvh_decode_leaves(&d, tris, s.ntris, err, sizeof err)) abort(); /* the leaf copy too */
+    if ((mode & 64) && d.usable && !d.leaf_tris) abort(); /* every ID names one of the soup's triangles */
     int nrays = 1 + get8(&rd) % 8;
     for (int i = 0; i < nrays; i++) {
         cbvh_ray ray;

@@ -43,6 +43,13 @@
 #define CBVH_RBF_ENABLED 0
 #endif
 
+#if defined(__SSE2__) && !defined(CBVH_NO_SSE2)
+#define CBVH_RBF_SSE2 1
+#include <emmintrin.h>
+#else
+#define CBVH_RBF_SSE2 0
+#endif
+
 typedef struct {
     double o[3], inv[3];
     double tmin;
@@ -139,21 +146,51 @@ static inline int cbvh_rbf_box(const cbvh_rbf_ray *p, double tmax, const double 
     return ok;
 }
 
+/* Plane [a][c] of a [3][2] array of binary32 (f32) or binary64 planes. */
+static inline double cbvh_rbf_plane(const void *planes, int f32, int a, int c) {
+    return f32 ? (double)((const float *)planes)[2 * a + c] : ((const double *)planes)[2 * a + c];
+}
+
 /* cbvh_rbf_box for two boxes at once (the children of a node): box c has
- * planes lo[a][c], hi[a][c].  Bit c of the result is set when box c is
- * decided; hit[c] and t_near[c] as for cbvh_rbf_box.  The same binary64
- * operations lane by lane, written as plain C over two-element arrays (no
- * compiler vector extensions; -O3 may pair the lanes itself). */
-static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const double lo[3][2],
-                                     const double hi[3][2], int check_planes, int hit[2], double t_near[2]) {
+ * planes lo[a][c], hi[a][c] ([3][2] arrays of binary64, or of binary32 when
+ * f32: their values exactly, converted on loading).  Bit c of the result is
+ * set when box c is decided; hit[c] and t_near[c] as for cbvh_rbf_box.  The
+ * same binary64 operations lane by lane, written as plain C over
+ * two-element arrays (no compiler vector extensions). */
+static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const void *lo, const void *hi, int f32,
+                                     int check_planes, int hit[2], double t_near[2]) {
     double nh[2] = {-HUGE_VAL, -HUGE_VAL}, fh[2] = {HUGE_VAL, HUGE_VAL};
     int okv[2] = {1, 1};
+#if CBVH_RBF_SSE2
+    if (!check_planes) {
+        __m128d vnh = _mm_set1_pd(-HUGE_VAL), vfh = _mm_set1_pd(HUGE_VAL);
+        for (int a = 0; a < 3; a++) {
+            const void *pn = p->near_hi[a] ? hi : lo, *pf = p->near_hi[a] ? lo : hi;
+            __m128d vn, vf;
+            if (f32) {
+                vn = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)((const float *)pn + 2 * a))));
+                vf = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)((const float *)pf + 2 * a))));
+            } else {
+                vn = _mm_loadu_pd((const double *)pn + 2 * a);
+                vf = _mm_loadu_pd((const double *)pf + 2 * a);
+            }
+            __m128d o = _mm_set1_pd(p->o[a]), inv = _mm_set1_pd(p->inv[a]);
+            vnh = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(vn, o), inv), vnh);
+            vfh = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(vf, o), inv), vfh);
+        }
+        _mm_storeu_pd(nh, vnh);
+        _mm_storeu_pd(fh, vfh);
+    } else
+#endif
     for (int a = 0; a < 3; a++) {
-        const double *pn = p->near_hi[a] ? hi[a] : lo[a], *pf = p->near_hi[a] ? lo[a] : hi[a];
+        const void *pn = p->near_hi[a] ? hi : lo, *pf = p->near_hi[a] ? lo : hi;
         for (int c = 0; c < 2; c++) {
-            double w = hi[a][c] - lo[a][c];
-            if (check_planes) okv[c] &= (w >= 0) & (w <= DBL_MAX);
-            double n = (pn[c] - p->o[a]) * p->inv[a], f = (pf[c] - p->o[a]) * p->inv[a];
+            if (check_planes) {
+                double w = cbvh_rbf_plane(hi, f32, a, c) - cbvh_rbf_plane(lo, f32, a, c);
+                okv[c] &= (w >= 0) & (w <= DBL_MAX);
+            }
+            double n = (cbvh_rbf_plane(pn, f32, a, c) - p->o[a]) * p->inv[a],
+                   f = (cbvh_rbf_plane(pf, f32, a, c) - p->o[a]) * p->inv[a];
             nh[c] = n > nh[c] ? n : nh[c];
             fh[c] = f < fh[c] ? f : fh[c];
         }
@@ -174,7 +211,7 @@ static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const d
 
 static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double lo[3][2], const double hi[3][2],
                                 int hit[2], double t_near[2]) {
-    return cbvh_rbf_box2_core(p, tmax, lo, hi, 1, hit, t_near);
+    return cbvh_rbf_box2_core(p, tmax, lo, hi, 0, 1, hit, t_near);
 }
 
 /* The same for planes known to satisfy lo < hi, both finite (the CBVH's
@@ -182,7 +219,13 @@ static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double
  * validity tests are skipped. */
 static inline int cbvh_rbf_box2_valid(const cbvh_rbf_ray *p, double tmax, const double lo[3][2],
                                       const double hi[3][2], int hit[2], double t_near[2]) {
-    return cbvh_rbf_box2_core(p, tmax, lo, hi, 0, hit, t_near);
+    return cbvh_rbf_box2_core(p, tmax, lo, hi, 0, 0, hit, t_near);
+}
+
+/* The same on binary32 planes (each exactly the binary64 plane). */
+static inline int cbvh_rbf_box2_valid_f32(const cbvh_rbf_ray *p, double tmax, const float lo[3][2],
+                                          const float hi[3][2], int hit[2], double t_near[2]) {
+    return cbvh_rbf_box2_core(p, tmax, lo, hi, 1, 0, hit, t_near);
 }
 
 /* An axis of a node's context (u = clb, e = scale in [-126, 126]) in

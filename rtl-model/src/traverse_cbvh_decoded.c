@@ -8,22 +8,69 @@
  * pair, walking the tree from the root as a traversal does; the traversal
  * below then runs cbvh_trace_cbvh's loop on the records.  Every box still
  * goes through the binary64 filter and, when it cannot decide, the box unit
- * on the grid planes, so hits and counters are the per-visit traversal's. */
+ * on the grid planes, so hits and counters are the per-visit traversal's.
+ * A record is one 64-byte line: the planes in binary32 when all twelve are
+ * binary32 numbers (their binary64 values exactly), else in a second array;
+ * what only the box unit's fallback needs (u, e, r, s) is kept apart. */
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "decode_fast.h"
 #include "traverse_cbvh_common.h"
 
-_Static_assert(sizeof(cbvh_cbvh_dnode) == 128, "one record per two 64-byte lines");
+_Static_assert(sizeof(cbvh_cbvh_dnode) == 64, "one record per 64-byte line");
 
 void cbvh_cbvh_decoded_free(cbvh_cbvh_decoded *d) {
     free(d->nodes);
     free(d->rel);
+    free(d->wide);
+    free(d->leaf_tris);
     d->nodes = NULL;
     d->rel = NULL;
+    d->wide = NULL;
+    d->leaf_tris = NULL;
+    d->leaf_src = NULL;
+    d->nwide = 0;
     d->usable = 0;
 }
+
+int cbvh_cbvh_decode_leaves(cbvh_cbvh_decoded *d, const cbvh_tri *tris, uint32_t ntris, char *err, size_t errlen) {
+    const cbvh_tree *t = d->tree;
+    free(d->leaf_tris);
+    d->leaf_tris = NULL;
+    d->leaf_src = NULL;
+    if (!d->usable || !tris || t->nids == 0) return 0;
+    for (uint32_t i = 0; i < t->nids; i++)
+        if ((t->ids[i] & ~CBVH_ID_LAST) >= ntris) return 0; /* left to the traversal's reads of tris */
+    d->leaf_tris = aligned_alloc(64, ((size_t)t->nids * sizeof *d->leaf_tris + 63) / 64 * 64);
+    if (!d->leaf_tris) {
+        snprintf(err, errlen, "decoded CBVH: out of memory (%u primitive IDs)", t->nids);
+        return -1;
+    }
+    for (uint32_t i = 0; i < t->nids; i++) {
+        memcpy(d->leaf_tris[i].v, tris[t->ids[i] & ~CBVH_ID_LAST].v, sizeof d->leaf_tris[i].v);
+        d->leaf_tris[i].id = t->ids[i];
+    }
+    d->leaf_src = tris;
+    return 0;
+}
+
+/* trav_cbvh_leaf on the copy: the same triangles in the same order, the
+ * same counters (the memory image is the tree's). */
+static int leaf_copy(trav_state *ts, const cbvh_cbvh_dtri *lt, uint32_t nids, uint32_t first, cbvh_f32 *cull,
+                     double *cull_d) {
+    for (uint32_t i = first; i < nids && !ts->done; i++) {
+        trav_fetch(ts, ts->ids_base + (uint64_t)i * 4u, 4u);
+        trav_triangle_v(ts, lt[i].id & ~CBVH_ID_LAST, (const cbvh_f32(*)[3])lt[i].v);
+        if (lt[i].id & CBVH_ID_LAST) break;
+    }
+    *cull = trav_box_tmax(ts);
+    *cull_d = cbvh_rbf_f32(*cull);
+    return ts->done;
+}
+
+/* x is exact in binary32 (x is finite: a plane u + c 2^e below 2^128). */
+static int exact_f32(double x) { return (double)(float)x == x; }
 
 typedef struct {
     uint32_t pair;
@@ -32,9 +79,11 @@ typedef struct {
 
 /* One pair's record from its context; 0 when the fast decode does not take
  * it (the per-visit traversal would then run the node-pair unit).  Pushes
- * the inner children with the contexts the traversal derives for them. */
+ * the inner children with the contexts the traversal derives for them.
+ * wide receives the binary64 planes; the caller keeps them only for a pair
+ * whose planes are not all exact in binary32 (flags EXACT without F32). */
 static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx, cbvh_cbvh_dnode *rec,
-                       cbvh_cbvh_drel *rel, walk_entry *push, int *npush) {
+                       cbvh_cbvh_drel *rel, cbvh_cbvh_dwide *wide, walk_entry *push, int *npush) {
     const cbvh_params *prm = &t->params;
     cbvh_fast_child fc[2];
     uint32_t ppm[3];
@@ -42,10 +91,10 @@ static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx,
     cbvh_rbf_axis ax[3];
     for (int a = 0; a < 3; a++) {
         ax[a] = cbvh_rbf_axis_prep(ctx->axis[a].clb, ctx->axis[a].scale);
-        rec->clb[a] = ctx->axis[a].clb;
-        rec->scale[a] = (int8_t)ctx->axis[a].scale;
+        rel->clb[a] = ctx->axis[a].clb;
+        rel->scale[a] = (int8_t)ctx->axis[a].scale;
     }
-    int exact = ax[0].exact & ax[1].exact & ax[2].exact;
+    int exact = ax[0].exact & ax[1].exact & ax[2].exact, f32 = exact;
     rec->flags = exact ? CBVH_DEC_EXACT : 0;
     for (int c = 0; c < 2; c++) {
         rec->child[c] = fc[c].ptr;
@@ -56,8 +105,9 @@ static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx,
             rel->s[c][a] = (uint16_t)(fc[c].empty ? 1 : fc[c].s[a]);
             lo[a] = ax[a].u + (double)rel->r[c][a] * ax[a].step;
             if (exact) {
-                rec->lo[a][c] = lo[a];
-                rec->hi[a][c] = ax[a].u + (double)rel->s[c][a] * ax[a].step;
+                wide->lo[a][c] = lo[a];
+                wide->hi[a][c] = ax[a].u + (double)rel->s[c][a] * ax[a].step;
+                f32 &= exact_f32(wide->lo[a][c]) & exact_f32(wide->hi[a][c]);
             }
         }
         if (fc[c].empty || fc[c].leaf) continue;
@@ -66,6 +116,14 @@ static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx,
         for (int a = 0; a < 3; a++)
             cbvh_fast_child_ctx(prm, t->enc, &ctx->axis[a], ppm[a], &fc[c], a, ax[a].exact ? &lo[a] : NULL,
                                 &w->ctx.axis[a]);
+    }
+    if (f32) {
+        rec->flags |= CBVH_DEC_F32;
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 2; c++) {
+                rec->lo[a][c] = (float)wide->lo[a][c];
+                rec->hi[a][c] = (float)wide->hi[a][c];
+            }
     }
     return 1;
 }
@@ -82,7 +140,9 @@ int cbvh_cbvh_decode(const cbvh_tree *t, cbvh_cbvh_decoded *out, char *err, size
     out->rel = malloc(n * sizeof *out->rel);
     walk_entry *stack = malloc((n + 2) * sizeof *stack);
     uint8_t *seen = calloc(n, 1);
-    if (!out->nodes || !out->rel || !stack || !seen) {
+    uint32_t cap = 16;
+    out->wide = malloc(cap * sizeof *out->wide);
+    if (!out->nodes || !out->rel || !stack || !seen || !out->wide) {
         free(stack);
         free(seen);
         cbvh_cbvh_decoded_free(out);
@@ -103,7 +163,21 @@ int cbvh_cbvh_decode(const cbvh_tree *t, cbvh_cbvh_decoded *out, char *err, size
             break;
         }
         seen[e.pair] = 1;
-        ok = decode_pair(t, e.pair, &e.ctx, &out->nodes[e.pair], &out->rel[e.pair], stack, &sp);
+        if (out->nwide == cap) { /* room for this pair's binary64 planes */
+            cbvh_cbvh_dwide *w = cap <= UINT32_MAX / 2 ? realloc(out->wide, 2 * (size_t)cap * sizeof *w) : NULL;
+            if (!w) {
+                free(stack);
+                free(seen);
+                cbvh_cbvh_decoded_free(out);
+                snprintf(err, errlen, "decoded CBVH: out of memory (%u node pairs)", t->npairs);
+                return -1;
+            }
+            out->wide = w;
+            cap *= 2;
+        }
+        cbvh_cbvh_dnode *rec = &out->nodes[e.pair];
+        ok = decode_pair(t, e.pair, &e.ctx, rec, &out->rel[e.pair], &out->wide[out->nwide], stack, &sp);
+        if (ok && (rec->flags & (CBVH_DEC_EXACT | CBVH_DEC_F32)) == CBVH_DEC_EXACT) rec->wide = out->nwide++;
     }
     free(stack);
     free(seen);
@@ -126,6 +200,7 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
     if (trav_begin(&ts, hit, ray, mant_bits, tris, mode, (uint64_t)t->npairs * t->pair_bytes, t->nids)) return -1;
     cbvh_rbf_ray fp;
     cbvh_rbf_prepare(ray, mant_bits, &fp);
+    const cbvh_cbvh_dtri *lt = d->leaf_tris && d->leaf_src == tris ? d->leaf_tris : NULL;
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;
     uint32_t max_stack = 0;
@@ -144,7 +219,8 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
         entry *e = &stack[--sp];
         if (e->t_near > cull_d) continue;
         if (e->leaf) {
-            if (trav_cbvh_leaf(&ts, t, e->ptr, &cull, &cull_d)) break;
+            if (lt ? leaf_copy(&ts, lt, t->nids, e->ptr, &cull, &cull_d) : trav_cbvh_leaf(&ts, t, e->ptr, &cull, &cull_d))
+                break;
             continue;
         }
         uint32_t p = e->ptr;
@@ -152,9 +228,28 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
         trav_fetch(&ts, (uint64_t)p * t->pair_bytes, t->pair_bytes);
         const cbvh_cbvh_dnode *rec = &d->nodes[p];
         uint32_t fl = rec->flags;
+        for (int c = 0; c < 2; c++) { /* start the children's loads before their box tests */
+            uint32_t q = rec->child[c];
+            if (fl & (CBVH_DEC_EMPTY0 << c)) continue;
+            if (!(fl & (CBVH_DEC_LEAF0 << c))) {
+                __builtin_prefetch(&d->nodes[q]);
+            } else if (q < t->nids) {
+                if (lt) { /* a leaf's first triangles */
+                    __builtin_prefetch(&lt[q]);
+                    if (q + 2 < t->nids) __builtin_prefetch(&lt[q + 2]);
+                } else {
+                    __builtin_prefetch(&t->ids[q]);
+                }
+            }
+        }
         double tn[2], tf[2] = {0, 0};
-        int h[2] = {0, 0}, hf[2] = {0, 0};
-        int dec = (fl & CBVH_DEC_EXACT) ? cbvh_rbf_box2_valid(&fp, cull_d, rec->lo, rec->hi, hf, tf) : 0;
+        int h[2] = {0, 0}, hf[2] = {0, 0}, dec = 0;
+        if (fl & CBVH_DEC_F32) { /* binary32 planes, exactly the binary64 ones */
+            dec = cbvh_rbf_box2_valid_f32(&fp, cull_d, rec->lo, rec->hi, hf, tf);
+        } else if (fl & CBVH_DEC_EXACT) {
+            const cbvh_cbvh_dwide *w = &d->wide[rec->wide];
+            dec = cbvh_rbf_box2_valid(&fp, cull_d, w->lo, w->hi, hf, tf);
+        }
         for (int c = 0; c < 2; c++) {
             if (fl & (CBVH_DEC_EMPTY0 << c)) continue;
             ts.s.box_tests++;
@@ -165,8 +260,8 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
             }
             cbvh_grid_axis g[3];
             for (int a = 0; a < 3; a++) {
-                g[a].u = rec->clb[a];
-                g[a].e = rec->scale[a];
+                g[a].u = d->rel[p].clb[a];
+                g[a].e = d->rel[p].scale[a];
                 g[a].r = d->rel[p].r[c][a];
                 g[a].s = d->rel[p].s[c][a];
             }
@@ -184,13 +279,6 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
             ne->t_near = tn[c];
         }
         if ((uint32_t)sp > max_stack) max_stack = (uint32_t)sp;
-        for (int k = sp - h[0] - h[1]; k < sp; k++) { /* what the pushed children read next */
-            if (stack[k].leaf) {
-                if (stack[k].ptr < t->nids) __builtin_prefetch(&t->ids[stack[k].ptr]);
-            } else {
-                __builtin_prefetch(&d->nodes[stack[k].ptr]);
-            }
-        }
     }
     ts.s.max_stack = max_stack;
     trav_finish(&ts, hit, st);

@@ -37,7 +37,12 @@ static inline uint64_t trav_align(uint64_t a) { return (a + CBVH_LINE_BYTES - 1)
  * nodes from address 0, then nids 4-byte primitive IDs, then the triangles. */
 static inline int trav_begin(trav_state *ts, cbvh_trav_hit *hit, const cbvh_ray *ray, int M, const cbvh_tri *tris,
                              cbvh_trav_mode mode, uint64_t node_bytes, uint64_t nids) {
-    memset(ts, 0, sizeof *ts);
+    /* only what is read before it is written (the state is 360 bytes, most of
+     * it the box unit's preparation, made on the first fallback) */
+    ts->prep.ray = NULL;
+    memset(&ts->best, 0, sizeof ts->best);
+    memset(&ts->s, 0, sizeof ts->s);
+    ts->done = 0;
     memset(hit, 0, sizeof *hit);
     if (cbvh_rb_ray_status(ray, M)) return -1;
     trav_set_ray(ts, ray);
@@ -71,9 +76,8 @@ static inline cbvh_f32 trav_box_tmax(const trav_state *ts) {
     return x == CBVH_F32_POS_INF ? x : cbvh_f32_next_up(x);
 }
 
-static inline void trav_triangle(trav_state *ts, uint32_t id) {
-    cbvh_f32 v[3][3];
-    memcpy(v, ts->tris[id].v, sizeof v);
+/* Triangle id with vertices v (ts->tris[id], or a copy of it). */
+static inline void trav_triangle_v(trav_state *ts, uint32_t id, const cbvh_f32 v[3][3]) {
     trav_fetch(ts, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
     ts->s.tri_tests++;
     cbvh_tri_result r;
@@ -91,6 +95,12 @@ static inline void trav_triangle(trav_state *ts, uint32_t id) {
     ts->best.b1 = r.b1;
     ts->best.b2 = r.b2;
     if (ts->mode & CBVH_TRAV_ANY) ts->done = 1;
+}
+
+static inline void trav_triangle(trav_state *ts, uint32_t id) {
+    cbvh_f32 v[3][3];
+    memcpy(v, ts->tris[id].v, sizeof v);
+    trav_triangle_v(ts, id, (const cbvh_f32(*)[3])v);
 }
 
 /* A ray the units reject (NaN/Inf, zero direction) is an error for the traversal. */

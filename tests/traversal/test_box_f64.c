@@ -4,7 +4,9 @@
  *     t_near equal the exact path's (cbvh_ray_box_*_exact_only) bit for bit;
  *     the claim that a grid plane is exact in binary64 is checked with an
  *     error-free sum (2Sum); the two-box version (cbvh_rbf_box2) equals the
- *     one-box version lane by lane;
+ *     one-box version lane by lane, and its variants for valid planes and
+ *     for binary32 planes (SSE2 on x86-64) equal it; test_box_f64_plain is
+ *     the same test with the two-box lanes in plain C (CBVH_NO_SSE2);
  *   - the node-pair decode for the traversal (rtl-model/src/decode_fast.h):
  *     accepts exactly the pairs the unit decodes with status 0 (N = 3..10) and
  *     then gives the same leaf/empty/pointer, relative coordinates and child
@@ -75,7 +77,7 @@ static cbvh_f32 plane_on_grid(cbvh_f32 o, cbvh_f32 d, int M, int nudge) {
 
 /* cbvh_rbf_box2 on (box, other box) equals cbvh_rbf_box on each lane. */
 static double prev_lo[3], prev_hi[3];
-static long n_valid_pairs;
+static long n_valid_pairs, n_f32_pairs;
 static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], const double hi[3], int dec, int hit,
                        double tn, long i) {
     double l2[3][2], h2[3][2], t2[2], tb = 0;
@@ -104,6 +106,23 @@ static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], c
         if (dv != d2 || ((dv & 1) && (hv[0] != hit2[0] || tv[0] != t2[0])) ||
             ((dv & 2) && (hv[1] != hit2[1] || tv[1] != t2[1]))) {
             if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2_valid differs from cbvh_rbf_box2\n", i);
+        }
+        /* and on binary32 planes, when every plane is one (the decoded CBVH's records) */
+        float l32[3][2], h32[3][2];
+        int all32 = 1;
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 2; c++) {
+                l32[a][c] = (float)l2[a][c];
+                h32[a][c] = (float)h2[a][c];
+                all32 &= (double)l32[a][c] == l2[a][c] && (double)h32[a][c] == h2[a][c];
+            }
+        if (all32) {
+            int df = cbvh_rbf_box2_valid_f32(p, tmax, (const float(*)[2])l32, (const float(*)[2])h32, hv, tv);
+            n_f32_pairs++;
+            if (df != d2 || ((df & 1) && (hv[0] != hit2[0] || tv[0] != t2[0])) ||
+                ((df & 2) && (hv[1] != hit2[1] || tv[1] != t2[1]))) {
+                if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2_valid_f32 differs from cbvh_rbf_box2\n", i);
+            }
         }
     }
     memcpy(prev_lo, lo, sizeof prev_lo);
@@ -469,8 +488,10 @@ int main(void) {
     test_filter_margin();
     test_grid_boxes();
     test_pair_decode();
-    printf("box pairs with valid planes (cbvh_rbf_box2_valid checked): %ld\n", n_valid_pairs);
-    if (n_valid_pairs < 100000) {
+    printf("box pairs with valid planes (cbvh_rbf_box2_valid checked): %ld, %ld of them binary32 "
+           "(cbvh_rbf_box2_valid_f32 checked); two-box lanes in %s\n",
+           n_valid_pairs, n_f32_pairs, CBVH_RBF_SSE2 ? "SSE2" : "plain C");
+    if (n_valid_pairs < 100000 || n_f32_pairs < 10000) {
         printf("FAIL: too few valid box pairs\n");
         failures++;
     }

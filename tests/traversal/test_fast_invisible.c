@@ -195,7 +195,9 @@ static void run_scene(int k) {
             exit(1);
         }
         for (size_t i = 0; i < (size_t)t[j].npairs * t[j].pair_bytes; i++) dg(t[j].pairs[i]); /* the trees too */
-        if (cbvh_cbvh_decode(&t[j], &dt[j], err, sizeof err) || dt[j].usable != CBVH_FAST_PATHS) {
+        if (cbvh_cbvh_decode(&t[j], &dt[j], err, sizeof err) || dt[j].usable != CBVH_FAST_PATHS ||
+            cbvh_cbvh_decode_leaves(&dt[j], s.tris, s.ntris, err, sizeof err) ||
+            (dt[j].leaf_tris != NULL) != CBVH_FAST_PATHS) {
             fprintf(stderr, "FAIL %s: decoded CBVH %d: usable %d (%s)\n", scene_name[k], j, dt[j].usable, err);
             exit(1);
         }

@@ -77,8 +77,9 @@ static int sum_exact(double a, double b) {
 /* Every reachable record against the node-pair unit (cbvh_nodepair_decode)
  * under contexts derived by the unit (cbvh_axis_child_ctx), independently of
  * the fast decode the records come from.  Returns the number of differences;
- * *exact counts the pairs whose planes are exact in binary64. */
-static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact) {
+ * *exact counts the pairs whose planes are exact in binary64, *f32 those
+ * whose planes are also exact in binary32. */
+static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact, long *f32) {
     const cbvh_tree *t = d->tree;
     const cbvh_params *p = &t->params;
     uint32_t *sp_pair = malloc(((size_t)t->npairs + 2) * sizeof *sp_pair);
@@ -96,30 +97,49 @@ static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact) {
             continue;
         }
         const cbvh_cbvh_dnode *rec = &d->nodes[i];
-        *exact += (rec->flags & CBVH_DEC_EXACT) != 0;
-        for (int a = 0; a < 3; a++) bad += rec->clb[a] != ctx.axis[a].clb || rec->scale[a] != ctx.axis[a].scale;
+        uint32_t rc[2][3], sc[2][3]; /* the unit's codes; an empty child: the dummy box 0, 1 */
+        for (int a = 0; a < 3; a++)
+            bad += d->rel[i].clb[a] != ctx.axis[a].clb || d->rel[i].scale[a] != ctx.axis[a].scale;
         for (int c = 0; c < 2; c++) {
             bad += ((rec->flags >> c) & 1) != (uint32_t)ch[c].leaf ||
                    ((rec->flags >> (2 + c)) & 1) != (uint32_t)ch[c].empty;
+            for (int a = 0; a < 3; a++) {
+                rc[c][a] = 0;
+                sc[c][a] = 1;
+                if (ch[c].empty) continue;
+                cbvh_axis_store_codes(p, CBVH_ENC_RELATIVE, &ctx.axis[a], &ch[c].axis[a], &rc[c][a], &sc[c][a]);
+                if (sc[c][a] == 0) sc[c][a] = 1u << p->quant_bits;
+                bad += d->rel[i].r[c][a] != rc[c][a] || d->rel[i].s[c][a] != sc[c][a];
+            }
             if (ch[c].empty) continue;
             bad += rec->child[c] != ch[c].ptr;
-            for (int a = 0; a < 3; a++) {
-                uint32_t r, s;
-                cbvh_axis_store_codes(p, CBVH_ENC_RELATIVE, &ctx.axis[a], &ch[c].axis[a], &r, &s);
-                if (s == 0) s = 1u << p->quant_bits;
-                bad += d->rel[i].r[c][a] != r || d->rel[i].s[c][a] != s;
-                if (rec->flags & CBVH_DEC_EXACT) { /* the filter's premise: u + r 2^e, u + s 2^e exact */
-                    double u = cbvh_float_of(ctx.axis[a].clb), lo = ldexp((double)r, ctx.axis[a].scale),
-                           hi = ldexp((double)s, ctx.axis[a].scale);
-                    bad += !sum_exact(u, lo) || !sum_exact(u, hi) || rec->lo[a][c] != u + lo ||
-                           rec->hi[a][c] != u + hi;
-                }
-            }
             if (ch[c].leaf) continue;
             sp_pair[sp] = ch[c].ptr;
             for (int a = 0; a < 3; a++) sp_ctx[sp].axis[a] = cbvh_axis_child_ctx(&ctx.axis[a], &ch[c].axis[a]);
             sp++;
         }
+        /* The planes, when the filter is to use them: binary32 in the record
+         * (F32, exactly when every one of the pair's twelve is a binary32) or
+         * binary64 in wide[]. */
+        uint32_t fl = rec->flags & (CBVH_DEC_EXACT | CBVH_DEC_F32);
+        *exact += (fl & CBVH_DEC_EXACT) != 0;
+        *f32 += (fl & CBVH_DEC_F32) != 0;
+        if (!(fl & CBVH_DEC_EXACT)) {
+            bad += fl != 0;
+            continue;
+        }
+        bad += fl == CBVH_DEC_EXACT && rec->wide >= d->nwide;
+        const cbvh_cbvh_dwide *w = fl == CBVH_DEC_EXACT && rec->wide < d->nwide ? &d->wide[rec->wide] : NULL;
+        int all32 = 1;
+        for (int c = 0; c < 2; c++)
+            for (int a = 0; a < 3; a++) { /* the filter's premise: u + r 2^e, u + s 2^e exact */
+                double u = cbvh_float_of(ctx.axis[a].clb), lo = ldexp((double)rc[c][a], ctx.axis[a].scale),
+                       hi = ldexp((double)sc[c][a], ctx.axis[a].scale);
+                double plo = w ? w->lo[a][c] : rec->lo[a][c], phi = w ? w->hi[a][c] : rec->hi[a][c];
+                bad += !sum_exact(u, lo) || !sum_exact(u, hi) || plo != u + lo || phi != u + hi;
+                all32 &= (double)(float)(u + lo) == u + lo && (double)(float)(u + hi) == u + hi;
+            }
+        bad += all32 != (fl == (CBVH_DEC_EXACT | CBVH_DEC_F32));
     }
     free(sp_pair);
     free(sp_ctx);
@@ -212,21 +232,35 @@ static void run_scene(const char *spec) {
             continue;
         }
         cbvh_trav_stats cs = {0}, ca = {0};
-        long mismatches = 0, exact = 0, dec_bad = 0;
+        long mismatches = 0, exact = 0, f32 = 0, dec_bad = 0;
         cbvh_cbvh_decoded dt;
         if (cbvh_cbvh_decode(&t, &dt, err, sizeof err) || !dt.usable) {
             fprintf(stderr, "FAIL decode %s N=%d: not usable (%s)\n", spec, cfg[c].N, err);
             failures++;
         } else {
-            dec_bad = decoded_vs_unit(&dt, &exact);
+            dec_bad = decoded_vs_unit(&dt, &exact, &f32);
             for (int i = 0; i < RAYS; i++)
                 for (int mode = 0; mode < 2; mode++)
                     dec_bad += !decoded_same(&dt, s.tris, &rays[i], cfg[c].M, (cbvh_trav_mode)mode);
+            /* with the leaves copied too: the copy holds each ID's triangle,
+             * and tracing with it is again the per-visit traversal */
+            if (cbvh_cbvh_decode_leaves(&dt, s.tris, s.ntris, err, sizeof err) || !dt.leaf_tris ||
+                dt.leaf_src != s.tris) {
+                fprintf(stderr, "FAIL decode leaves %s: %s\n", spec, err);
+                failures++;
+            } else {
+                for (uint32_t i = 0; i < t.nids; i++)
+                    dec_bad += dt.leaf_tris[i].id != t.ids[i] ||
+                               memcmp(dt.leaf_tris[i].v, s.tris[t.ids[i] & ~CBVH_ID_LAST].v, sizeof s.tris[0].v);
+                for (int i = 0; i < RAYS; i++)
+                    for (int mode = 0; mode < 2; mode++)
+                        dec_bad += !decoded_same(&dt, s.tris, &rays[i], cfg[c].M, (cbvh_trav_mode)mode);
+            }
         }
         /* nearly every pair of these scenes has binary64-exact planes (the filter's case) */
         if (dec_bad || exact * 10 < (long)t.npairs * 9) {
-            fprintf(stderr, "FAIL decoded CBVH %s N=%d M=%d: %ld differences, %ld of %u pairs exact\n", spec,
-                    cfg[c].N, cfg[c].M, dec_bad, exact, t.npairs);
+            fprintf(stderr, "FAIL decoded CBVH %s N=%d M=%d: %ld differences, %ld of %u pairs exact (%ld in binary32)\n",
+                    spec, cfg[c].N, cfg[c].M, dec_bad, exact, t.npairs, f32);
             failures++;
         }
         cbvh_cbvh_decoded_free(&dt);
@@ -255,8 +289,9 @@ static void run_scene(const char *spec) {
                (double)cs.box_tests / RAYS, (double)cs.box_tests / (double)fs.box_tests, (double)cs.tri_tests / RAYS,
                (double)cs.tri_tests / (double)fs.tri_tests, (double)cs.bytes / RAYS,
                (double)cs.bytes / (double)fs.bytes, cs.max_stack, (double)ca.box_tests / RAYS, mismatches);
-        printf("%-22s N=%-2d M=%-2d %-8s decoded once: %u pairs, %ld exact in binary64, %d x 2 rays identical\n",
-               spec, cfg[c].N, cfg[c].M, cbvh_encoding_name(cfg[c].enc), t.npairs, exact, RAYS);
+        printf("%-22s N=%-2d M=%-2d %-8s decoded once: %u pairs, %ld exact in binary64 (%ld in binary32), "
+               "%d x 2 rays identical\n",
+               spec, cfg[c].N, cfg[c].M, cbvh_encoding_name(cfg[c].enc), t.npairs, exact, f32, RAYS);
         if (cs.box_tests < fs.box_tests) {
             fprintf(stderr, "FAIL %s N=%d: CBVH box tests %llu < float %llu\n", spec, cfg[c].N,
                     (unsigned long long)cs.box_tests, (unsigned long long)fs.box_tests);
@@ -468,6 +503,46 @@ static void decoded_malformed(void) {
     }
 }
 
+/* The leaf copy (cbvh_cbvh_decode_leaves): tracing reads it only when given
+ * the triangle array it was copied from, and reads the array it is given
+ * otherwise; an ID not below ntris, or a decoded copy that is not usable:
+ * no leaf copy (0, not an error). */
+static void decoded_leaves(void) {
+    for (int padded = 0; padded < 2; padded++) {
+        cbvh_tree t;
+        uint8_t pair[32];
+        uint32_t id = CBVH_ID_LAST; /* triangle 0, the leaf's last */
+        if (one_pair_cbvh(&t, pair, 1, 0, padded)) {
+            failures++;
+            return;
+        }
+        t.ids = &id;
+        t.nids = 1;
+        cbvh_tri tri = {{{0, 0, 0.5f}, {1, 0, 0.5f}, {0, 1, 0.5f}}}, moved = tri; /* floats */
+        for (int k = 0; k < 3; k++) moved.v[k][2] = 0.25f;
+        cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(2)}, {0, 0, fb(-1)}, 0, CBVH_F32_POS_INF};
+        cbvh_cbvh_decoded dt;
+        char err[256] = "";
+        int ok = cbvh_cbvh_decode(&t, &dt, err, sizeof err) == 0 && dt.usable == !padded &&
+                 cbvh_cbvh_decode_leaves(&dt, &tri, 1, err, sizeof err) == 0 && (dt.leaf_tris == NULL) == padded &&
+                 decoded_same(&dt, &tri, &r, 24, CBVH_TRAV_CLOSEST) &&
+                 decoded_same(&dt, &moved, &r, 24, CBVH_TRAV_CLOSEST);
+        cbvh_trav_hit h1 = {0}, h2 = {0};
+        cbvh_trav_stats st = {0};
+        ok = ok && cbvh_trace_cbvh_decoded(&dt, &tri, &r, 24, CBVH_TRAV_CLOSEST, &h1, &st) == 0 &&
+             cbvh_trace_cbvh_decoded(&dt, &moved, &r, 24, CBVH_TRAV_CLOSEST, &h2, &st) == 0 && h1.hit && h2.hit &&
+             h1.t == fb(1.5f) && h2.t == fb(1.75f);
+        ok = ok && cbvh_cbvh_decode_leaves(&dt, &tri, 0, err, sizeof err) == 0 && !dt.leaf_tris && !dt.leaf_src &&
+             decoded_same(&dt, &tri, &r, 24, CBVH_TRAV_CLOSEST);
+        if (!ok) {
+            fprintf(stderr, "FAIL decoded CBVH leaf copy (%s pairs): usable %d, copy %d, hits %d %d at %08x %08x (%s)\n",
+                    padded ? "padded" : "plain", dt.usable, dt.leaf_tris != NULL, h1.hit, h2.hit, h1.t, h2.t, err);
+            failures++;
+        }
+        cbvh_cbvh_decoded_free(&dt);
+    }
+}
+
 /* The byte counters follow the memory image of docs/traversal.md §5 (node
  * pairs from 0, then the 4-byte IDs, then the 36-byte triangles, each region
  * on a 64-byte line; every read counts the lines it covers): a one-pair CBVH
@@ -520,6 +595,7 @@ int main(void) {
     layout_cases();
     cyclic_cbvh();
     decoded_malformed();
+    decoded_leaves();
     memory_map();
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
     run_scene("proc:far:8");

@@ -93,34 +93,54 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
 
 /* The CBVH decoded once (docs/traversal.md §12): per node pair, what
  * cbvh_trace_cbvh derives from it on every visit — both children's planes
- * u + r 2^e, u + s 2^e in binary64 when every one is exact there, their
- * pointers and leaf and empty bits, the pair's context (u and e of each axis)
- * and, apart, the relative coordinates r, s for the box unit's fallback.  The
+ * u + r 2^e, u + s 2^e when every one is exact in binary64, their pointers
+ * and leaf and empty bits; apart, the pair's context (u and e of each axis)
+ * and the relative coordinates r, s for the box unit's fallback.  The
  * records come from the same decode (decode_fast.h) and the same context
  * derivation as the traversal's, so tracing with them gives
  * cbvh_trace_cbvh's outputs and counters bit for bit; only the decode's
- * repetition is gone.  128 + 24 bytes per pair (the CBVH itself: 16 or 24). */
+ * repetition is gone.  The planes are kept in binary32 when every one is
+ * exact there (one 64-byte line per pair: the traversal reads nothing else
+ * unless the filter cannot decide), else in binary64 in a second array.
+ * 64 + 40 bytes per pair, 96 more for a pair with binary64 planes (the CBVH
+ * itself: 16 or 24). */
 #define CBVH_DEC_LEAF0 1u  /* flags: child 0 a leaf, ... */
 #define CBVH_DEC_EMPTY0 4u /* ... child 0 empty (child 1: the bit doubled) */
-#define CBVH_DEC_EXACT 16u /* every plane exact in binary64: lo, hi valid, the binary64 box filter applies */
+#define CBVH_DEC_EXACT 16u /* every plane exact in binary64: the binary64 box filter applies */
+#define CBVH_DEC_F32 32u   /* with EXACT: every plane exact in binary32 too, kept in lo, hi */
 typedef struct {
-    double lo[3][2], hi[3][2]; /* [axis][child]; an empty child's box is a dummy; 0 unless EXACT */
-    uint32_t child[2];         /* pointer: a pair index, or a leaf's first ID */
-    cbvh_f32 clb[3];           /* u: the context's lower bound per axis */
-    int8_t scale[3];           /* e: the context's scale per axis, in [-126, 126] */
+    float lo[3][2], hi[3][2]; /* [axis][child] with F32; an empty child's box is a dummy; else 0 */
+    uint32_t child[2];        /* pointer: a pair index, or a leaf's first ID */
+    uint32_t wide;            /* EXACT without F32: the planes' index in wide[]; else 0 */
     uint8_t flags;
-    uint8_t pad[8];
+    uint8_t pad[3];
 } cbvh_cbvh_dnode;
 
 typedef struct {
+    double lo[3][2], hi[3][2]; /* as in cbvh_cbvh_dnode, in binary64 */
+} cbvh_cbvh_dwide;
+
+typedef struct {
     uint16_t r[2][3], s[2][3]; /* [child][axis]; s in [1, 2^N]; an empty child: 0, 1 */
+    cbvh_f32 clb[3];           /* u: the context's lower bound per axis */
+    int8_t scale[3];           /* e: the context's scale per axis, in [-126, 126] */
+    uint8_t pad;
 } cbvh_cbvh_drel;
+
+typedef struct {
+    cbvh_f32 v[3][3]; /* the triangle's vertices */
+    uint32_t id;      /* its ID as in the tree's ID array (CBVH_ID_LAST included) */
+} cbvh_cbvh_dtri;
 
 typedef struct {
     const cbvh_tree *tree;  /* not owned; must outlive the decoded copy */
     int usable;             /* 0: every pair is decoded on its visit (see cbvh_cbvh_decode) */
     cbvh_cbvh_dnode *nodes; /* npairs records, 64-byte aligned, indexed by pair */
     cbvh_cbvh_drel *rel;    /* npairs, indexed by pair */
+    cbvh_cbvh_dwide *wide;  /* nwide binary64 plane sets, indexed by cbvh_cbvh_dnode.wide */
+    uint32_t nwide;
+    const cbvh_tri *leaf_src; /* the triangles copied into leaf_tris (cbvh_cbvh_decode_leaves), or NULL */
+    cbvh_cbvh_dtri *leaf_tris; /* tree->nids records in ID order: a leaf's triangles side by side */
 } cbvh_cbvh_decoded;
 
 /* Decode every pair reachable from the root.  0, or -1 with a one-line reason
@@ -131,6 +151,14 @@ typedef struct {
  * range, a pair reached twice): those trees keep every error and counter of
  * cbvh_trace_cbvh. */
 int cbvh_cbvh_decode(const cbvh_tree *t, cbvh_cbvh_decoded *out, char *err, size_t errlen);
+
+/* Optionally, the leaves too: a copy of each ID's triangle in ID order, so a
+ * leaf's triangles are read side by side instead of through the ID array.
+ * Tracing uses it when given the same tris pointer (which must not change
+ * while the copy is in use) and reads tris otherwise.  0 (copy made, or not:
+ * decoded copy not usable, an ID not below ntris), or -1 with a one-line
+ * reason (out of memory).  40 bytes per ID. */
+int cbvh_cbvh_decode_leaves(cbvh_cbvh_decoded *d, const cbvh_tri *tris, uint32_t ntris, char *err, size_t errlen);
 void cbvh_cbvh_decoded_free(cbvh_cbvh_decoded *d);
 
 /* cbvh_trace_cbvh(d->tree, ...) with the pairs' decodes taken from d: the same
