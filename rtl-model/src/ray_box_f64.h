@@ -146,6 +146,49 @@ static inline int cbvh_rbf_box(const cbvh_rbf_ray *p, double tmax, const double 
     return ok;
 }
 
+#if CBVH_RBF_SSE2
+/* cbvh_rbf_decided for both lanes of b, when mask < 2^30: the exponent and
+ * the low K bits sit in each lane's low 32 bits, where signed 32-bit compares
+ * are exact; the verdict is spread over the lane's 64 bits.  lowmax is
+ * mask - 6 in each 32-bit lane (low <= mask - 7). */
+static inline __m128i cbvh_rbf_decided2(__m128i b, __m128i mask, __m128i lowmax) {
+    __m128i ex = _mm_and_si128(_mm_srli_epi64(b, 52), _mm_set1_epi64x(0x7FF));
+    __m128i low = _mm_and_si128(b, mask);
+    __m128i ok = _mm_and_si128(_mm_cmpgt_epi32(ex, _mm_set1_epi32(1023 - 127)),
+                               _mm_cmpgt_epi32(_mm_set1_epi32(1023 + 127), ex)); /* E in [-126, 126] */
+    ok = _mm_and_si128(ok, _mm_and_si128(_mm_cmpgt_epi32(low, _mm_set1_epi32(7)), _mm_cmpgt_epi32(lowmax, low)));
+    return _mm_shuffle_epi32(ok, _MM_SHUFFLE(2, 2, 0, 0));
+}
+
+/* Per lane: neg where b is negative, else pos (its sign spread over the lane). */
+static inline __m128i cbvh_rbf_by_sign2(__m128i b, __m128i neg, __m128i pos) {
+    __m128i s = _mm_shuffle_epi32(_mm_srai_epi32(b, 31), _MM_SHUFFLE(3, 3, 1, 1));
+    return _mm_or_si128(_mm_and_si128(s, neg), _mm_andnot_si128(s, pos));
+}
+
+/* The end of cbvh_rbf_box2_core (valid planes) with both lanes in SSE2
+ * registers: the same decidability tests, cbvh_rbf_rd / cbvh_rbf_ru, clamps
+ * (maxpd(n, tmin) is n > tmin ? n : tmin, minpd(f, tmax) is f < tmax ? f :
+ * tmax) and comparison, lane by lane. */
+static inline int cbvh_rbf_finish2_sse2(const cbvh_rbf_ray *p, double tmax, __m128d vnh, __m128d vfh, int hit[2],
+                                        double t_near[2]) {
+    __m128i mask = _mm_set1_epi64x((long long)p->mask), lowmax = _mm_set1_epi32((int)p->mask - 6);
+    __m128i bn = _mm_castpd_si128(vnh), bf = _mm_castpd_si128(vfh);
+    __m128i dec = _mm_and_si128(cbvh_rbf_decided2(bn, mask, lowmax), cbvh_rbf_decided2(bf, mask, lowmax));
+    __m128i one = _mm_set1_epi64x(1);
+    __m128i n_up = _mm_add_epi64(_mm_or_si128(bn, mask), one), n_down = _mm_andnot_si128(mask, bn);
+    __m128i f_up = _mm_add_epi64(_mm_or_si128(bf, mask), one), f_down = _mm_andnot_si128(mask, bf);
+    __m128d n = _mm_castsi128_pd(cbvh_rbf_by_sign2(bn, n_up, n_down)); /* RD */
+    __m128d f = _mm_castsi128_pd(cbvh_rbf_by_sign2(bf, f_down, f_up)); /* RU */
+    __m128d tn = _mm_max_pd(n, _mm_set1_pd(p->tmin)), tf = _mm_min_pd(f, _mm_set1_pd(tmax));
+    int hm = _mm_movemask_pd(_mm_cmple_pd(tn, tf));
+    hit[0] = hm & 1;
+    hit[1] = hm >> 1;
+    _mm_storeu_pd(t_near, tn);
+    return p->ok ? _mm_movemask_pd(_mm_castsi128_pd(dec)) : 0;
+}
+#endif
+
 /* Plane [a][c] of a [3][2] array of binary32 (f32) or binary64 planes. */
 static inline double cbvh_rbf_plane(const void *planes, int f32, int a, int c) {
     return f32 ? (double)((const float *)planes)[2 * a + c] : ((const double *)planes)[2 * a + c];
@@ -178,6 +221,8 @@ static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const v
             vnh = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(vn, o), inv), vnh);
             vfh = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(vf, o), inv), vfh);
         }
+        if (p->mask <= 0x3FFFFFFFu) /* M >= 23: the low K bits fit a 32-bit lane */
+            return cbvh_rbf_finish2_sse2(p, tmax, vnh, vfh, hit, t_near);
         _mm_storeu_pd(nh, vnh);
         _mm_storeu_pd(fh, vfh);
     } else

@@ -240,6 +240,7 @@ static cbvh_f32 unit_rd(cbvh_f32 u, uint32_t r, int e) {
 }
 
 static void test_grid_boxes(void) {
+    long rd32_total = 0, rd32_taken = 0;
     long decided = 0, exact_axes = 0, typical_total = 0, typical_decided = 0;
     for (long i = 0; i < NBOX; i++) {
         int wide = (i & 3) == 0, M;
@@ -305,7 +306,10 @@ static void test_grid_boxes(void) {
         /* the decoded lower bound RD(u + r 2^e), as the traversal rounds it */
         for (int a = 0; a < 3; a++) {
             cbvh_f32 c;
-            if (!ax[a].exact || !cbvh_rbf_rd32(dlo[a], &c)) continue;
+            if (!ax[a].exact) continue;
+            rd32_total++;
+            if (!cbvh_rbf_rd32(dlo[a], &c)) continue;
+            rd32_taken++;
             cbvh_f32 want = unit_rd(g[a].u, g[a].r, g[a].e);
             if (c != want) {
                 if (failures++ < 10) printf("FAIL rd32: u=%08x e=%d r=%u: %08x, unit %08x\n", g[a].u, g[a].e, g[a].r, c, want);
@@ -316,8 +320,14 @@ static void test_grid_boxes(void) {
             typical_decided += dec;
         }
     }
-    printf("grid planes: %d boxes, %ld axes exact in binary64, filter decided %ld (scene-like: %.4f)\n", NBOX,
-           exact_axes, decided, (double)typical_decided / (double)typical_total);
+    printf("grid planes: %d boxes, %ld axes exact in binary64, filter decided %ld (scene-like: %.4f); "
+           "RD to binary32 of the lower plane done in binary64 on %ld of %ld exact axes\n", NBOX,
+           exact_axes, decided, (double)typical_decided / (double)typical_total, rd32_taken, rd32_total);
+    /* the fast RD must take the common case, or the child contexts' fast path is gone */
+    if (rd32_taken * 10 < rd32_total * 9) {
+        printf("FAIL: cbvh_rbf_rd32 leaves too many lower planes to the units\n");
+        failures++;
+    }
     if ((double)typical_decided < 0.9 * (double)typical_total) {
         printf("FAIL: the filter decides too few scene-like grid boxes\n");
         failures++;

@@ -534,6 +534,9 @@ static void decoded_leaves(void) {
              h1.t == fb(1.5f) && h2.t == fb(1.75f);
         ok = ok && cbvh_cbvh_decode_leaves(&dt, &tri, 0, err, sizeof err) == 0 && !dt.leaf_tris && !dt.leaf_src &&
              decoded_same(&dt, &tri, &r, 24, CBVH_TRAV_CLOSEST);
+        /* the record of a pair with an empty slot (its dummy box [u, u + 2^e]) */
+        long exact = 0, f32 = 0;
+        ok = ok && (padded || (decoded_vs_unit(&dt, &exact, &f32) == 0 && exact == 1 && f32 == 1));
         if (!ok) {
             fprintf(stderr, "FAIL decoded CBVH leaf copy (%s pairs): usable %d, copy %d, hits %d %d at %08x %08x (%s)\n",
                     padded ? "padded" : "plain", dt.usable, dt.leaf_tris != NULL, h1.hit, h2.hit, h1.t, h2.t, err);
