@@ -55,6 +55,7 @@ typedef struct {
     double tmin;
     uint64_t mask; /* 2^K - 1, K = 53 - M */
     int near_hi[3]; /* d_a < 0: the near plane is the upper one */
+    int near_at[3], far_at[3]; /* index of axis a's near / far plane of box 0 in a [2][3][2] plane array */
     int ok;         /* the filter applies to this ray (finite, no zero d_a, valid M) */
 } cbvh_rbf_ray;
 
@@ -88,6 +89,8 @@ static inline void cbvh_rbf_prepare(const cbvh_ray *ray, int M, cbvh_rbf_ray *p)
         double d = cbvh_rbf_f32(ray->d[a]);
         p->inv[a] = 1.0 / d;
         p->near_hi[a] = d < 0;
+        p->near_at[a] = 6 * (d < 0) + 2 * a; /* an index, not a branch per axis and box pair */
+        p->far_at[a] = 6 * !(d < 0) + 2 * a;
     }
     p->tmin = cbvh_rbf_f32(ray->tmin);
     if (M >= CBVH_MANT_MIN && M <= CBVH_MANT_MAX) p->mask = (UINT64_C(1) << (53 - M)) - 1u;
@@ -189,33 +192,35 @@ static inline int cbvh_rbf_finish2_sse2(const cbvh_rbf_ray *p, double tmax, __m1
 }
 #endif
 
-/* Plane [a][c] of a [3][2] array of binary32 (f32) or binary64 planes. */
-static inline double cbvh_rbf_plane(const void *planes, int f32, int a, int c) {
-    return f32 ? (double)((const float *)planes)[2 * a + c] : ((const double *)planes)[2 * a + c];
+/* Element i of a plane array of binary32 (f32) or binary64 values. */
+static inline double cbvh_rbf_plane(const void *planes, int f32, int i) {
+    return f32 ? (double)((const float *)planes)[i] : ((const double *)planes)[i];
 }
 
 /* cbvh_rbf_box for two boxes at once (the children of a node): box c has
- * planes lo[a][c], hi[a][c] ([3][2] arrays of binary64, or of binary32 when
- * f32: their values exactly, converted on loading).  Bit c of the result is
- * set when box c is decided; hit[c] and t_near[c] as for cbvh_rbf_box.  The
- * same binary64 operations lane by lane, written as plain C over
- * two-element arrays (no compiler vector extensions). */
-static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const void *lo, const void *hi, int f32,
-                                     int check_planes, int hit[2], double t_near[2]) {
+ * planes pl[0][a][c] (lower) and pl[1][a][c] (upper), a [2][3][2] array of
+ * binary64, or of binary32 when f32 (their values exactly, converted on
+ * loading).  Bit c of the result is set when box c is decided; hit[c] and
+ * t_near[c] as for cbvh_rbf_box.  The same binary64 operations lane by lane,
+ * written as plain C over two-element arrays (no compiler vector
+ * extensions), or in SSE2 registers (see CBVH_RBF_SSE2). */
+static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const void *pl, int f32, int check_planes,
+                                     int hit[2], double t_near[2]) {
     double nh[2] = {-HUGE_VAL, -HUGE_VAL}, fh[2] = {HUGE_VAL, HUGE_VAL};
     int okv[2] = {1, 1};
 #if CBVH_RBF_SSE2
     if (!check_planes) {
         __m128d vnh = _mm_set1_pd(-HUGE_VAL), vfh = _mm_set1_pd(HUGE_VAL);
         for (int a = 0; a < 3; a++) {
-            const void *pn = p->near_hi[a] ? hi : lo, *pf = p->near_hi[a] ? lo : hi;
             __m128d vn, vf;
             if (f32) {
-                vn = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)((const float *)pn + 2 * a))));
-                vf = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)((const float *)pf + 2 * a))));
+                const float *f = pl;
+                vn = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(f + p->near_at[a]))));
+                vf = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(f + p->far_at[a]))));
             } else {
-                vn = _mm_loadu_pd((const double *)pn + 2 * a);
-                vf = _mm_loadu_pd((const double *)pf + 2 * a);
+                const double *d = pl;
+                vn = _mm_loadu_pd(d + p->near_at[a]);
+                vf = _mm_loadu_pd(d + p->far_at[a]);
             }
             __m128d o = _mm_set1_pd(p->o[a]), inv = _mm_set1_pd(p->inv[a]);
             vnh = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(vn, o), inv), vnh);
@@ -228,14 +233,13 @@ static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const v
     } else
 #endif
     for (int a = 0; a < 3; a++) {
-        const void *pn = p->near_hi[a] ? hi : lo, *pf = p->near_hi[a] ? lo : hi;
         for (int c = 0; c < 2; c++) {
             if (check_planes) {
-                double w = cbvh_rbf_plane(hi, f32, a, c) - cbvh_rbf_plane(lo, f32, a, c);
+                double w = cbvh_rbf_plane(pl, f32, 6 + 2 * a + c) - cbvh_rbf_plane(pl, f32, 2 * a + c);
                 okv[c] &= (w >= 0) & (w <= DBL_MAX);
             }
-            double n = (cbvh_rbf_plane(pn, f32, a, c) - p->o[a]) * p->inv[a],
-                   f = (cbvh_rbf_plane(pf, f32, a, c) - p->o[a]) * p->inv[a];
+            double n = (cbvh_rbf_plane(pl, f32, p->near_at[a] + c) - p->o[a]) * p->inv[a],
+                   f = (cbvh_rbf_plane(pl, f32, p->far_at[a] + c) - p->o[a]) * p->inv[a];
             nh[c] = n > nh[c] ? n : nh[c];
             fh[c] = f < fh[c] ? f : fh[c];
         }
@@ -254,23 +258,23 @@ static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const v
     return res;
 }
 
-static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double lo[3][2], const double hi[3][2],
-                                int hit[2], double t_near[2]) {
-    return cbvh_rbf_box2_core(p, tmax, lo, hi, 0, 1, hit, t_near);
+static inline int cbvh_rbf_box2(const cbvh_rbf_ray *p, double tmax, const double pl[2][3][2], int hit[2],
+                                double t_near[2]) {
+    return cbvh_rbf_box2_core(p, tmax, pl, 0, 1, hit, t_near);
 }
 
 /* The same for planes known to satisfy lo < hi, both finite (the CBVH's
  * decoded grid planes u + r 2^e < u + s 2^e, exact in binary64): the
  * validity tests are skipped. */
-static inline int cbvh_rbf_box2_valid(const cbvh_rbf_ray *p, double tmax, const double lo[3][2],
-                                      const double hi[3][2], int hit[2], double t_near[2]) {
-    return cbvh_rbf_box2_core(p, tmax, lo, hi, 0, 0, hit, t_near);
+static inline int cbvh_rbf_box2_valid(const cbvh_rbf_ray *p, double tmax, const double pl[2][3][2], int hit[2],
+                                      double t_near[2]) {
+    return cbvh_rbf_box2_core(p, tmax, pl, 0, 0, hit, t_near);
 }
 
 /* The same on binary32 planes (each exactly the binary64 plane). */
-static inline int cbvh_rbf_box2_valid_f32(const cbvh_rbf_ray *p, double tmax, const float lo[3][2],
-                                          const float hi[3][2], int hit[2], double t_near[2]) {
-    return cbvh_rbf_box2_core(p, tmax, lo, hi, 1, 0, hit, t_near);
+static inline int cbvh_rbf_box2_valid_f32(const cbvh_rbf_ray *p, double tmax, const float pl[2][3][2], int hit[2],
+                                          double t_near[2]) {
+    return cbvh_rbf_box2_core(p, tmax, pl, 1, 0, hit, t_near);
 }
 
 /* An axis of a node's context (u = clb, e = scale in [-126, 126]) in

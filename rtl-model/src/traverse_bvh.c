@@ -80,15 +80,15 @@ int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray,
         trav_fetch(&ts, (uint64_t)ni * 64u, 64u);
         uint32_t c0 = n->child[0], c1 = n->child[1];
         const cbvh_bvh_node *n0 = &nodes[c0], *n1 = &nodes[c1];
-        double lo[3][2], hi[3][2], tn2[2];
+        double pl[2][3][2], tn2[2]; /* [lower, upper][axis][child] */
         int hit2[2];
         for (int a = 0; a < 3; a++) {
-            lo[a][0] = n0->lo[a];
-            lo[a][1] = n1->lo[a];
-            hi[a][0] = n0->hi[a];
-            hi[a][1] = n1->hi[a];
+            pl[0][a][0] = n0->lo[a];
+            pl[0][a][1] = n1->lo[a];
+            pl[1][a][0] = n0->hi[a];
+            pl[1][a][1] = n1->hi[a];
         }
-        int dec = cbvh_rbf_box2(&fp, cull_d, lo, hi, hit2, tn2);
+        int dec = cbvh_rbf_box2(&fp, cull_d, (const double(*)[3][2])pl, hit2, tn2);
         double t0 = tn2[0], t1 = tn2[1];
         int h0 = hit2[0], h1 = hit2[1];
         ts.s.box_tests += 2;

@@ -75,15 +75,15 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
             cbvh_rbf_axis ax[3];
             for (int a = 0; a < 3; a++) ax[a] = cbvh_rbf_axis_prep(ctx.axis[a].clb, ctx.axis[a].scale);
             int exact = ax[0].exact & ax[1].exact & ax[2].exact;
-            double lo[3][2], hi[3][2], tf[2] = {0, 0};
+            double pl[2][3][2], tf[2] = {0, 0}; /* [lower, upper][axis][child] */
             int hf[2] = {0, 0};
             for (int a = 0; a < 3; a++)
                 for (int c = 0; c < 2; c++) { /* an empty slot gets a dummy box, its lane is ignored */
-                    lo[a][c] = ax[a].u + (double)(fc[c].empty ? 0 : fc[c].r[a]) * ax[a].step;
-                    hi[a][c] = ax[a].u + (double)(fc[c].empty ? 1 : fc[c].s[a]) * ax[a].step;
+                    pl[0][a][c] = ax[a].u + (double)(fc[c].empty ? 0 : fc[c].r[a]) * ax[a].step;
+                    pl[1][a][c] = ax[a].u + (double)(fc[c].empty ? 1 : fc[c].s[a]) * ax[a].step;
                 }
             /* r < s (the decode's check) and exact finite planes: valid boxes */
-            int dec = exact ? cbvh_rbf_box2_valid(&fp, cull_d, lo, hi, hf, tf) : 0;
+            int dec = exact ? cbvh_rbf_box2_valid(&fp, cull_d, (const double(*)[3][2])pl, hf, tf) : 0;
             for (int c = 0; c < 2; c++) {
                 if (fc[c].empty) continue;
                 ts.s.box_tests++;
@@ -115,7 +115,7 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
                 if (ne->leaf) continue; /* a leaf entry's context is never read */
                 for (int a = 0; a < 3; a++) {
                     cbvh_fast_child_ctx(prm, t->enc, &ctx.axis[a], ppm[a], &fc[c], a,
-                                        ax[a].exact ? &lo[a][c] : NULL, &ne->ctx.axis[a]);
+                                        ax[a].exact ? &pl[0][a][c] : NULL, &ne->ctx.axis[a]);
                 }
             }
         } else {

@@ -105,9 +105,9 @@ static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx,
             rel->s[c][a] = (uint16_t)(fc[c].empty ? 1 : fc[c].s[a]);
             lo[a] = ax[a].u + (double)rel->r[c][a] * ax[a].step;
             if (exact) {
-                wide->lo[a][c] = lo[a];
-                wide->hi[a][c] = ax[a].u + (double)rel->s[c][a] * ax[a].step;
-                f32 &= exact_f32(wide->lo[a][c]) & exact_f32(wide->hi[a][c]);
+                wide->pl[0][a][c] = lo[a];
+                wide->pl[1][a][c] = ax[a].u + (double)rel->s[c][a] * ax[a].step;
+                f32 &= exact_f32(wide->pl[0][a][c]) & exact_f32(wide->pl[1][a][c]);
             }
         }
         if (fc[c].empty || fc[c].leaf) continue;
@@ -119,11 +119,9 @@ static int decode_pair(const cbvh_tree *t, uint32_t i, const cbvh_node_ctx *ctx,
     }
     if (f32) {
         rec->flags |= CBVH_DEC_F32;
-        for (int a = 0; a < 3; a++)
-            for (int c = 0; c < 2; c++) {
-                rec->lo[a][c] = (float)wide->lo[a][c];
-                rec->hi[a][c] = (float)wide->hi[a][c];
-            }
+        for (int k = 0; k < 2; k++)
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 2; c++) rec->pl[k][a][c] = (float)wide->pl[k][a][c];
     }
     return 1;
 }
@@ -245,10 +243,10 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
         double tn[2], tf[2] = {0, 0};
         int h[2] = {0, 0}, hf[2] = {0, 0}, dec = 0;
         if (fl & CBVH_DEC_F32) { /* binary32 planes, exactly the binary64 ones */
-            dec = cbvh_rbf_box2_valid_f32(&fp, cull_d, rec->lo, rec->hi, hf, tf);
+            dec = cbvh_rbf_box2_valid_f32(&fp, cull_d, rec->pl, hf, tf);
         } else if (fl & CBVH_DEC_EXACT) {
             const cbvh_cbvh_dwide *w = &d->wide[rec->wide];
-            dec = cbvh_rbf_box2_valid(&fp, cull_d, w->lo, w->hi, hf, tf);
+            dec = cbvh_rbf_box2_valid(&fp, cull_d, w->pl, hf, tf);
         }
         for (int c = 0; c < 2; c++) {
             if (fl & (CBVH_DEC_EMPTY0 << c)) continue;

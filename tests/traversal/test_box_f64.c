@@ -80,16 +80,16 @@ static double prev_lo[3], prev_hi[3];
 static long n_valid_pairs, n_f32_pairs;
 static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], const double hi[3], int dec, int hit,
                        double tn, long i) {
-    double l2[3][2], h2[3][2], t2[2], tb = 0;
+    double pl[2][3][2], t2[2], tb = 0; /* [lower, upper][axis][box] */
     int hit2[2], hb = 0;
     for (int a = 0; a < 3; a++) {
-        l2[a][0] = lo[a];
-        h2[a][0] = hi[a];
-        l2[a][1] = prev_lo[a];
-        h2[a][1] = prev_hi[a];
+        pl[0][a][0] = lo[a];
+        pl[1][a][0] = hi[a];
+        pl[0][a][1] = prev_lo[a];
+        pl[1][a][1] = prev_hi[a];
     }
     int decb = cbvh_rbf_box(p, tmax, prev_lo, prev_hi, &hb, &tb);
-    int d2 = cbvh_rbf_box2(p, tmax, (const double(*)[2])l2, (const double(*)[2])h2, hit2, t2);
+    int d2 = cbvh_rbf_box2(p, tmax, (const double(*)[3][2])pl, hit2, t2);
     if (d2 != (dec | decb << 1) || (dec && (hit2[0] != hit || t2[0] != tn)) ||
         (decb && (hit2[1] != hb || t2[1] != tb))) {
         if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2 differs from cbvh_rbf_box\n", i);
@@ -97,27 +97,27 @@ static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], c
     /* the variant without validity tests, on pairs of valid boxes (lo < hi, finite) */
     int valid = 1;
     for (int a = 0; a < 3; a++)
-        for (int c = 0; c < 2; c++) valid &= l2[a][c] < h2[a][c] && isfinite(l2[a][c]) && isfinite(h2[a][c]);
+        for (int c = 0; c < 2; c++) valid &= pl[0][a][c] < pl[1][a][c] && isfinite(pl[0][a][c]) && isfinite(pl[1][a][c]);
     if (valid) {
         int hv[2];
         double tv[2];
-        int dv = cbvh_rbf_box2_valid(p, tmax, (const double(*)[2])l2, (const double(*)[2])h2, hv, tv);
+        int dv = cbvh_rbf_box2_valid(p, tmax, (const double(*)[3][2])pl, hv, tv);
         n_valid_pairs++;
         if (dv != d2 || ((dv & 1) && (hv[0] != hit2[0] || tv[0] != t2[0])) ||
             ((dv & 2) && (hv[1] != hit2[1] || tv[1] != t2[1]))) {
             if (failures++ < 10) printf("FAIL box pair %ld: cbvh_rbf_box2_valid differs from cbvh_rbf_box2\n", i);
         }
         /* and on binary32 planes, when every plane is one (the decoded CBVH's records) */
-        float l32[3][2], h32[3][2];
+        float p32[2][3][2];
         int all32 = 1;
-        for (int a = 0; a < 3; a++)
-            for (int c = 0; c < 2; c++) {
-                l32[a][c] = (float)l2[a][c];
-                h32[a][c] = (float)h2[a][c];
-                all32 &= (double)l32[a][c] == l2[a][c] && (double)h32[a][c] == h2[a][c];
-            }
+        for (int k = 0; k < 2; k++)
+            for (int a = 0; a < 3; a++)
+                for (int c = 0; c < 2; c++) {
+                    p32[k][a][c] = (float)pl[k][a][c];
+                    all32 &= (double)p32[k][a][c] == pl[k][a][c];
+                }
         if (all32) {
-            int df = cbvh_rbf_box2_valid_f32(p, tmax, (const float(*)[2])l32, (const float(*)[2])h32, hv, tv);
+            int df = cbvh_rbf_box2_valid_f32(p, tmax, (const float(*)[3][2])p32, hv, tv);
             n_f32_pairs++;
             if (df != d2 || ((df & 1) && (hv[0] != hit2[0] || tv[0] != t2[0])) ||
                 ((df & 2) && (hv[1] != hit2[1] || tv[1] != t2[1]))) {

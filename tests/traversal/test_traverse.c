@@ -135,7 +135,7 @@ static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact, long *f32) 
             for (int a = 0; a < 3; a++) { /* the filter's premise: u + r 2^e, u + s 2^e exact */
                 double u = cbvh_float_of(ctx.axis[a].clb), lo = ldexp((double)rc[c][a], ctx.axis[a].scale),
                        hi = ldexp((double)sc[c][a], ctx.axis[a].scale);
-                double plo = w ? w->lo[a][c] : rec->lo[a][c], phi = w ? w->hi[a][c] : rec->hi[a][c];
+                double plo = w ? w->pl[0][a][c] : rec->pl[0][a][c], phi = w ? w->pl[1][a][c] : rec->pl[1][a][c];
                 bad += !sum_exact(u, lo) || !sum_exact(u, hi) || plo != u + lo || phi != u + hi;
                 all32 &= (double)(float)(u + lo) == u + lo && (double)(float)(u + hi) == u + hi;
             }

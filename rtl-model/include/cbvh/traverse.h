@@ -107,9 +107,9 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
 #define CBVH_DEC_LEAF0 1u  /* flags: child 0 a leaf, ... */
 #define CBVH_DEC_EMPTY0 4u /* ... child 0 empty (child 1: the bit doubled) */
 #define CBVH_DEC_EXACT 16u /* every plane exact in binary64: the binary64 box filter applies */
-#define CBVH_DEC_F32 32u   /* with EXACT: every plane exact in binary32 too, kept in lo, hi */
+#define CBVH_DEC_F32 32u   /* with EXACT: every plane exact in binary32 too, kept in pl */
 typedef struct {
-    float lo[3][2], hi[3][2]; /* [axis][child] with F32; an empty child's box is a dummy; else 0 */
+    float pl[2][3][2];        /* [lower, upper][axis][child] with F32; an empty child's box is a dummy; else 0 */
     uint32_t child[2];        /* pointer: a pair index, or a leaf's first ID */
     uint32_t wide;            /* EXACT without F32: the planes' index in wide[]; else 0 */
     uint8_t flags;
@@ -117,7 +117,7 @@ typedef struct {
 } cbvh_cbvh_dnode;
 
 typedef struct {
-    double lo[3][2], hi[3][2]; /* as in cbvh_cbvh_dnode, in binary64 */
+    double pl[2][3][2]; /* as in cbvh_cbvh_dnode, in binary64 */
 } cbvh_cbvh_dwide;
 
 typedef struct {
