@@ -12,6 +12,8 @@
  * A record is one 64-byte line: the planes in binary32 when all twelve are
  * binary32 numbers (their binary64 values exactly), else in a second array;
  * what only the box unit's fallback needs (u, e, r, s) is kept apart. */
+#include <float.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -69,8 +71,9 @@ static int leaf_copy(trav_state *ts, const cbvh_cbvh_dtri *lt, uint32_t nids, ui
     return ts->done;
 }
 
-/* x is exact in binary32 (x is finite: a plane u + c 2^e below 2^128). */
-static int exact_f32(double x) { return (double)(float)x == x; }
+/* x (a finite plane u + c 2^e, up to 2^137) is a binary32 number; beyond
+ * FLT_MAX the conversion would overflow, so that is tested first. */
+static int exact_f32(double x) { return fabs(x) <= FLT_MAX && (double)(float)x == x; }
 
 typedef struct {
     uint32_t pair;

@@ -17,6 +17,7 @@
  * distances exactly on the M-bit grid and one binary32 ulp beside it, origins
  * on planes, power-of-two directions, zero / subnormal / huge bounds, -Inf
  * context bounds, random and corrupted node-pair bytes. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -113,8 +114,9 @@ static void check_pair(const cbvh_rbf_ray *p, double tmax, const double lo[3], c
         for (int k = 0; k < 2; k++)
             for (int a = 0; a < 3; a++)
                 for (int c = 0; c < 2; c++) {
-                    p32[k][a][c] = (float)pl[k][a][c];
-                    all32 &= (double)p32[k][a][c] == pl[k][a][c];
+                    int fits = fabs(pl[k][a][c]) <= FLT_MAX; /* valid planes are finite; the conversion must not overflow */
+                    p32[k][a][c] = fits ? (float)pl[k][a][c] : 0.0f;
+                    all32 &= fits && (double)p32[k][a][c] == pl[k][a][c];
                 }
         if (all32) {
             int df = cbvh_rbf_box2_valid_f32(p, tmax, (const float(*)[3][2])p32, hv, tv);

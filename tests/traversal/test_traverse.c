@@ -18,6 +18,7 @@
  *     per-visit traversal (usable = 0) and keep its results;
  * scenes: scenes/bunny-small.obj, proc:far (far from the origin), proc:cloth
  * (a plane hit edge-on and at grazing angles). */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -137,7 +138,8 @@ static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact, long *f32) 
                        hi = ldexp((double)sc[c][a], ctx.axis[a].scale);
                 double plo = w ? w->pl[0][a][c] : rec->pl[0][a][c], phi = w ? w->pl[1][a][c] : rec->pl[1][a][c];
                 bad += !sum_exact(u, lo) || !sum_exact(u, hi) || plo != u + lo || phi != u + hi;
-                all32 &= (double)(float)(u + lo) == u + lo && (double)(float)(u + hi) == u + hi;
+                all32 &= fabs(u + hi) <= FLT_MAX && (double)(float)(u + lo) == u + lo &&
+                         (double)(float)(u + hi) == u + hi; /* u >= -FLT_MAX, u + lo < u + hi: no overflow */
             }
         bad += all32 != (fl == (CBVH_DEC_EXACT | CBVH_DEC_F32));
     }
