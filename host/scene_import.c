@@ -10,9 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <limits.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "scene_load.h"
@@ -702,7 +705,10 @@ fail:
  * the glTF reader, found by fuzz_mesh_import), and no check of ours can
  * stand in front of every reader.  So assimp runs in a forked child that
  * sends the finished scene (or its one-line error) back through a pipe; a
- * child that dies first becomes a one-line error here. */
+ * child that dies first becomes a one-line error here.  Some readers also
+ * loop forever on malformed input (the PLY reader on a header found by
+ * fuzz_mesh_import), so the child gets a time limit: 5 s plus 1 s per MB of
+ * file, far beyond what assimp needs for a well-formed file of that size. */
 typedef struct {
     int32_t rc;
     uint32_t ntris, nmorph, nkeys;
@@ -722,14 +728,28 @@ static int write_full(int fd, const void *buf, size_t n) {
     return 0;
 }
 
-static int read_full(int fd, void *buf, size_t n) {
+static long long now_ms(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+/* read_full until a deadline (now_ms() time): 0, -1 cut short, -3 too late. */
+static int read_until(int fd, void *buf, size_t n, long long deadline) {
     char *p = buf;
     while (n) {
-        ssize_t k = read(fd, p, n);
+        long long left = deadline - now_ms();
+        if (left <= 0) return -3;
+        struct pollfd pfd = {fd, POLLIN, 0};
+        int k = poll(&pfd, 1, left > INT_MAX ? INT_MAX : (int)left);
         if (k < 0 && errno == EINTR) continue;
-        if (k <= 0) return -1;
-        p += k;
-        n -= (size_t)k;
+        if (k == 0) return -3;
+        if (k < 0) return -1;
+        ssize_t r = read(fd, p, n);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) return -1;
+        p += r;
+        n -= (size_t)r;
     }
     return 0;
 }
@@ -780,8 +800,8 @@ static void child_import(const char *path, int fd) {
 }
 
 /* The scene the child sends after a reply with rc = 0, into out (zeroed).
- * 0, -1 if it is cut short, -2 out of memory. */
-static int read_scene(int fd, const import_reply *r, cbvh_scene *out) {
+ * 0, -1 if it is cut short, -2 out of memory, -3 past the deadline. */
+static int read_scene(int fd, const import_reply *r, cbvh_scene *out, long long deadline) {
     if (r->ntris == 0 || r->ntris >= 0x80000000u || r->nmorph > 64 || r->nkeys > (1u << 24)) return -1;
     out->ntris = r->ntris;
     out->nmorph = r->nmorph;
@@ -794,13 +814,15 @@ static int read_scene(int fd, const import_reply *r, cbvh_scene *out) {
     for (int a = 0; a < SCENE_ARRAYS; a++) {
         if (!len[a]) continue;
         if (!(*ptr[a] = malloc(len[a]))) return -2;
-        if (read_full(fd, *ptr[a], len[a])) return -1;
+        int rc = read_until(fd, *ptr[a], len[a], deadline);
+        if (rc) return rc;
     }
     return 0;
 }
 
-static int import_isolated(const char *path, cbvh_scene *out, char *err, size_t errlen) {
+static int import_isolated(const char *path, long long size, cbvh_scene *out, char *err, size_t errlen) {
     memset(out, 0, sizeof *out);
+    long long limit_ms = 5000 + size / 1000; /* 5 s + 1 s per MB */
     int fds[2];
     if (pipe(fds)) {
         snprintf(err, errlen, "cannot import '%s': pipe: %s", path, strerror(errno));
@@ -820,11 +842,19 @@ static int import_isolated(const char *path, cbvh_scene *out, char *err, size_t 
     }
     close(fds[1]);
     import_reply r;
-    int got = read_full(fds[0], &r, sizeof r) == 0 ? 0 : -1;
-    if (got == 0 && r.rc == 0) got = read_scene(fds[0], &r, out);
+    long long deadline = now_ms() + limit_ms;
+    int got = read_until(fds[0], &r, sizeof r, deadline);
+    if (got == 0 && r.rc == 0) got = read_scene(fds[0], &r, out, deadline);
     close(fds[0]); /* a child still writing gets EPIPE and ends */
+    if (got == -3) kill(pid, SIGKILL); /* a reader caught in a loop */
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (got == -3) {
+        cbvh_scene_free(out);
+        snprintf(err, errlen, "cannot import '%s': the importer (assimp) did not finish within %lld s", path,
+                 limit_ms / 1000);
+        return -1;
     }
     if (got == -2) {
         cbvh_scene_free(out);
@@ -876,7 +906,7 @@ int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errle
         return -1;
     }
     if (off_check(path, err, errlen) || ply_check(path, (long long)st.st_size, err, errlen)) return -1;
-    return import_isolated(path, out, err, errlen);
+    return import_isolated(path, (long long)st.st_size, out, err, errlen);
 }
 
 int cbvh_scene_open(const char *spec, cbvh_scene *out, char *err, size_t errlen) {
