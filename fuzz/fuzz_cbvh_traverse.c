@@ -11,12 +11,16 @@
  *     with or without its leaf copy, gives the per-visit traversal's return
  *     value, hit and counters;
  *   - on an uncorrupted tree both succeed and hit exactly what brute force
- *     over the ray-triangle unit hits (closest: the same triangle and t). */
+ *     over the ray-triangle unit hits (closest: the same triangle and t);
+ *   - so do the plain float traversals of the float BVH (binary, and 4-wide
+ *     over its QBVH collapse, with the leaf copy when bit 64 is set), and
+ *     they reject (-1) the rays the units reject. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cbvh/cbvh_tree.h"
+#include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 
 typedef struct {
@@ -95,8 +99,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     } else {
         rc = cbvh_compress_topdown(&b, &o, &t, err, sizeof err);
     }
-    cbvh_bvh_free(&b);
-    if (rc) return 0;
+    if (rc) {
+        cbvh_bvh_free(&b);
+        return 0;
+    }
+    /* the float BVH's plain traversals (uncorrupted: built from b) */
+    cbvh_fbvh fb;
+    cbvh_qbvh qb;
+    cbvh_fqbvh fq;
+    if (cbvh_fbvh_build(&b, &fb, err, sizeof err) || cbvh_qbvh_from_bvh(&b, &qb, err, sizeof err) ||
+        cbvh_fqbvh_build(&qb, (mode & 64) ? tris : NULL, s.ntris, &fq, err, sizeof err))
+        abort(); /* a BVH the builders emit is one the layouts take */
+    if ((mode & 64) && !fq.leaf_tris) abort();
     int corrupt = get8(&rd) % 4;
     for (int k = 0; k < corrupt && t.npairs; k++) t.pairs[get32(&rd) % (t.npairs * t.pair_bytes)] ^= get8(&rd);
     if (mode & 8) {
@@ -123,12 +137,27 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             int r1 = cbvh_trace_cbvh(&t, tris, &ray, M, (cbvh_trav_mode)m, &h1, &s1);
             int r2 = cbvh_trace_cbvh_decoded(&d, tris, &ray, M, (cbvh_trav_mode)m, &h2, &s2);
             if (r1 != r2 || memcmp(&h1, &h2, sizeof h1) || memcmp(&s1, &s2, sizeof s1)) abort();
-            if (corrupt || brute(tris, s.ntris, &ray, &want)) continue; /* a ray the units reject: -1 above */
+            cbvh_trav_hit hf, hq;
+            int rf = cbvh_trace_bvh_float(&fb, tris, &ray, (cbvh_trav_mode)m, &hf, &s2);
+            int rq = cbvh_trace_qbvh_float(&fq, tris, &ray, (cbvh_trav_mode)m, &hq, &s2);
+            int rejected = brute(tris, s.ntris, &ray, &want);
+            if (rejected) { /* a ray the units reject */
+                if (rf != -1 || rq != -1 || hf.hit || hq.hit) abort();
+                continue;
+            }
+            if (rf || hf.hit != want.hit || rq || hq.hit != want.hit) abort();
+            if (m == 0 && want.hit && (hf.prim != want.prim || hf.t != want.t || hq.prim != want.prim || hq.t != want.t))
+                abort();
+            if (corrupt) continue; /* -1 or any result above */
             if (r1 || h1.hit != want.hit) abort();
             if (m == 0 && want.hit && (h1.prim != want.prim || h1.t != want.t)) abort();
         }
     }
     cbvh_cbvh_decoded_free(&d);
     cbvh_tree_free(&t);
+    cbvh_fqbvh_free(&fq);
+    cbvh_qbvh_free(&qb);
+    cbvh_fbvh_free(&fb);
+    cbvh_bvh_free(&b);
     return 0;
 }

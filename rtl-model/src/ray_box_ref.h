@@ -20,17 +20,27 @@
 #include "cbvh/fp32.h"
 #include "cbvh/traversal_units.h"
 
+#if defined(__SSE2__) && !defined(CBVH_NO_SSE2)
+#define CBVH_REF_SSE2 1
+#include <emmintrin.h>
+#else
+#define CBVH_REF_SSE2 0
+#endif
+
 #define CBVH_REF_EPS 0x1p-50 /* > 2 * 3.0000001 * 2^-53 */
 
 /* A pair of boxes as 12 binary32: plane (lo = 0, hi = 1) of axis a of child c
- * at [CBVH_REF_AT(plane, a, c)]. */
+ * at [CBVH_REF_AT(plane, a, c)]; four boxes as 24 at [CBVH_REF4_AT(...)]. */
 #define CBVH_REF_AT(plane, a, c) (((plane) * 3 + (a)) * 2 + (c))
+#define CBVH_REF4_AT(plane, a, c) (((plane) * 3 + (a)) * 4 + (c))
 
 typedef struct {
     double o[3], inv[3]; /* inv = 1 / d, 0 where d = +-0 */
     double tmin;
     int pn[3], pf[3]; /* CBVH_REF_AT(near / far plane, a, 0): the near plane is hi where d_a < 0 */
+    int pn4[3], pf4[3]; /* the same for CBVH_REF4_AT */
     int general;      /* some d_a = +-0, or tmin < 0: cbvh_ref_box2_any, not cbvh_ref_box2 */
+    _Alignas(16) double o2[3][2], inv2[3][2]; /* o, inv twice: an SSE2 register's two lanes */
 } cbvh_ref_ray;
 
 /* For a ray the units accept (finite, d != 0). */
@@ -42,6 +52,10 @@ static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
         r->inv[a] = d != 0 ? 1.0 / d : 0;
         r->pn[a] = CBVH_REF_AT(d < 0, a, 0);
         r->pf[a] = CBVH_REF_AT(!(d < 0), a, 0);
+        r->pn4[a] = CBVH_REF4_AT(d < 0, a, 0);
+        r->pf4[a] = CBVH_REF4_AT(!(d < 0), a, 0);
+        r->o2[a][0] = r->o2[a][1] = r->o[a];
+        r->inv2[a][0] = r->inv2[a][1] = r->inv[a];
         axis_par |= d == 0;
     }
     r->tmin = cbvh_float_of(ray->tmin);
@@ -53,9 +67,11 @@ static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
  * may meet box c, and then t_lo[c] <= its exact entry t.  Here N >= 0 and F
  * has its exact sign, so N_exact <= F_exact implies N <= F * (1 + 2^-50) and
  * N * (1 - 2^-50) <= N_exact (the margins also cover these two products'
- * own roundings).  Both children go through the same operations. */
-static inline void cbvh_ref_box2(const cbvh_ref_ray *r, const float box[12], double cull, int hit[2],
-                                 double t_lo[2]) {
+ * own roundings).  Both children go through the same operations: plain C
+ * here, lane by lane in SSE2 registers in cbvh_ref_box2 (same results bit
+ * for bit; tests/traversal/test_box_f64.c compares them). */
+static inline void cbvh_ref_box2_c(const cbvh_ref_ray *r, const float box[12], double cull, int hit[2],
+                                   double t_lo[2]) {
     double n0 = r->tmin, n1 = r->tmin, f0 = cull, f1 = cull;
     for (int a = 0; a < 3; a++) {
         const float *pn = box + r->pn[a], *pf = box + r->pf[a];
@@ -73,29 +89,98 @@ static inline void cbvh_ref_box2(const cbvh_ref_ray *r, const float box[12], dou
     hit[1] = n1 <= f1 * (1 + CBVH_REF_EPS);
 }
 
+/* cbvh_ref_box2_c with child c in lane c: a child's two planes of an axis
+ * are adjacent binary32 values, loaded and widened together; maxpd(t, n) is
+ * t > n ? t : n and minpd(t, f) is t < f ? t : f, as in the C. */
+static inline void cbvh_ref_box2(const cbvh_ref_ray *r, const float box[12], double cull, int hit[2],
+                                 double t_lo[2]) {
+#if CBVH_REF_SSE2
+    __m128d n = _mm_set1_pd(r->tmin), f = _mm_set1_pd(cull);
+    for (int a = 0; a < 3; a++) {
+        __m128d pn = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(box + r->pn[a]))));
+        __m128d pf = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(box + r->pf[a]))));
+        __m128d o = _mm_set1_pd(r->o[a]), inv = _mm_set1_pd(r->inv[a]);
+        n = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(pn, o), inv), n);
+        f = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(pf, o), inv), f);
+    }
+    _mm_storeu_pd(t_lo, _mm_mul_pd(n, _mm_set1_pd(1 - CBVH_REF_EPS)));
+    int hm = _mm_movemask_pd(_mm_cmple_pd(n, _mm_mul_pd(f, _mm_set1_pd(1 + CBVH_REF_EPS))));
+    hit[0] = hm & 1;
+    hit[1] = hm >> 1;
+#else
+    cbvh_ref_box2_c(r, box, cull, hit, t_lo);
+#endif
+}
+
 /* Any valid ray (zero direction components, tmin < 0): an axis with d_a = 0
  * constrains nothing where o_a lies in the closed slab, else the box is
- * missed; the slack is the sign-free N <= F + (|N| + |F|) * 2^-50. */
-static inline void cbvh_ref_box2_any(const cbvh_ref_ray *r, const float box[12], double cull, int hit[2],
-                                     double t_lo[2]) {
-    double nn[2] = {r->tmin, r->tmin}, ff[2] = {cull, cull};
-    int in[2] = {1, 1};
-    for (int a = 0; a < 3; a++) {
-        for (int c = 0; c < 2; c++) {
+ * missed; the slack is the sign-free N <= F + (|N| + |F|) * 2^-50.  w boxes
+ * (2 or 4), plane of axis a of box c at ((plane * 3) + a) * w + c. */
+static inline void cbvh_ref_boxw_any(const cbvh_ref_ray *r, const float *box, int w, double cull, int *hit,
+                                     double *t_lo) {
+    for (int c = 0; c < w; c++) {
+        double nn = r->tmin, ff = cull;
+        int in = 1;
+        for (int a = 0; a < 3; a++) {
+            double lo = box[(0 * 3 + a) * w + c], hi = box[(1 * 3 + a) * w + c];
             if (r->inv[a] == 0) {
-                in[c] &= r->o[a] >= box[CBVH_REF_AT(0, a, c)] && r->o[a] <= box[CBVH_REF_AT(1, a, c)];
+                in &= r->o[a] >= lo && r->o[a] <= hi;
                 continue;
             }
-            double tn = ((double)box[r->pn[a] + c] - r->o[a]) * r->inv[a];
-            double tf = ((double)box[r->pf[a] + c] - r->o[a]) * r->inv[a];
-            nn[c] = tn > nn[c] ? tn : nn[c];
-            ff[c] = tf < ff[c] ? tf : ff[c];
+            int neg = r->inv[a] < 0;
+            double tn = ((neg ? hi : lo) - r->o[a]) * r->inv[a];
+            double tf = ((neg ? lo : hi) - r->o[a]) * r->inv[a];
+            nn = tn > nn ? tn : nn;
+            ff = tf < ff ? tf : ff;
         }
+        t_lo[c] = nn - fabs(nn) * CBVH_REF_EPS;
+        hit[c] = in && nn <= ff + (fabs(nn) + fabs(ff)) * CBVH_REF_EPS;
     }
-    for (int c = 0; c < 2; c++) {
-        t_lo[c] = nn[c] - fabs(nn[c]) * CBVH_REF_EPS;
-        hit[c] = in[c] && nn[c] <= ff[c] + (fabs(nn[c]) + fabs(ff[c])) * CBVH_REF_EPS;
+}
+
+static inline void cbvh_ref_box2_any(const cbvh_ref_ray *r, const float box[12], double cull, int hit[2],
+                                     double t_lo[2]) {
+    cbvh_ref_boxw_any(r, box, 2, cull, hit, t_lo);
+}
+
+/* cbvh_ref_box2 on four boxes (a 4-wide node, planes at CBVH_REF4_AT):
+ * lane by lane the same operations, so the same results as cbvh_ref_box2_c
+ * on any two of them.  Returns the hit mask (bit c for box c). */
+static inline int cbvh_ref_box4(const cbvh_ref_ray *r, const float box[24], double cull, double t_lo[4]) {
+#if CBVH_REF_SSE2
+    __m128d n01 = _mm_set1_pd(r->tmin), n23 = n01, f01 = _mm_set1_pd(cull), f23 = f01;
+    for (int a = 0; a < 3; a++) { /* lanes c, c + 1 of a plane row: two binary32 widened */
+        const float *pn = box + r->pn4[a], *pf = box + r->pf4[a];
+        __m128d o = _mm_load_pd(r->o2[a]), inv = _mm_load_pd(r->inv2[a]);
+        __m128d pn01 = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)pn)));
+        __m128d pn23 = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(pn + 2))));
+        __m128d pf01 = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)pf)));
+        __m128d pf23 = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(pf + 2))));
+        n01 = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(pn01, o), inv), n01);
+        n23 = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(pn23, o), inv), n23);
+        f01 = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(pf01, o), inv), f01);
+        f23 = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(pf23, o), inv), f23);
     }
+    __m128d lo = _mm_set1_pd(1 - CBVH_REF_EPS), hi = _mm_set1_pd(1 + CBVH_REF_EPS);
+    _mm_storeu_pd(t_lo, _mm_mul_pd(n01, lo));
+    _mm_storeu_pd(t_lo + 2, _mm_mul_pd(n23, lo));
+    return _mm_movemask_pd(_mm_cmple_pd(n01, _mm_mul_pd(f01, hi))) |
+           _mm_movemask_pd(_mm_cmple_pd(n23, _mm_mul_pd(f23, hi))) << 2;
+#else
+    int m = 0;
+    for (int c = 0; c < 4; c++) {
+        double n = r->tmin, f = cull;
+        for (int a = 0; a < 3; a++) {
+            double tn = ((double)box[r->pn4[a] + c] - r->o[a]) * r->inv[a];
+            double tf = ((double)box[r->pf4[a] + c] - r->o[a]) * r->inv[a];
+            n = tn > n ? tn : n;
+            f = tf < f ? tf : f;
+        }
+        t_lo[c] = n * (1 - CBVH_REF_EPS);
+        m |= (n <= f * (1 + CBVH_REF_EPS)) << c;
+    }
+    return m;
+#endif
 }
 
 /* The variant the ray calls for. */

@@ -8,6 +8,7 @@
 
 #include "ray_box_ref.h"
 #include "traverse_common.h"
+#include "traverse_plain.h"
 
 _Static_assert(sizeof(cbvh_fbvh_node) == 64, "one record per 64-byte line");
 
@@ -107,10 +108,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
 
     /* the stack holds child entries as in the records: a record index, or
      * CBVH_FBVH_LEAF | first and the count */
-    struct {
-        uint32_t entry, count;
-        double t_lo; /* lower bound of its entry t */
-    } stack[CBVH_TRAV_STACK];
+    plain_entry stack[CBVH_TRAV_STACK];
     int sp = 0;
     uint32_t max_stack = 0;
     uint64_t nodes = 0;
@@ -142,9 +140,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
             int next = -1; /* the child visited next, if any */
             if (h[0] & h[1]) { /* push the farther (ties: child 1), visit the nearer */
                 int far = tl[1] < tl[0] ? 0 : 1;
-                stack[sp].entry = n->child[far];
-                stack[sp].count = n->count[far];
-                stack[sp++].t_lo = tl[far];
+                plain_push(stack, &sp, n->child[far], n->count[far], tl[far]);
                 next = far ^ 1;
             } else if (h[0] | h[1]) {
                 next = h[1];
@@ -159,14 +155,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
                 }
             }
         }
-        /* pop the next entry not culled since it was pushed */
-        have = 0;
-        while (sp > 0 && !have) {
-            sp--;
-            have = !(stack[sp].t_lo > cull);
-            e = stack[sp].entry;
-            cnt = stack[sp].count;
-        }
+        have = plain_pop(stack, &sp, cull, &e, &cnt);
     }
     ts.s.nodes += nodes;
     ts.s.box_tests += 2 * nodes;

@@ -11,6 +11,11 @@
  *     accepts exactly the pairs the unit decodes with status 0 (N = 3..10) and
  *     then gives the same leaf/empty/pointer, relative coordinates and child
  *     contexts as cbvh_nodepair_decode + cbvh_axis_child_ctx;
+ *   - the plain float traversals' slab test (rtl-model/src/ray_box_ref.h):
+ *     cbvh_ref_box2 (SSE2 lanes on x86-64) and the four-box cbvh_ref_box4
+ *     equal the plain C cbvh_ref_box2_c bit for bit on every box (whose
+ *     conservativeness tests/traversal/test_ray_box.c checks against exact
+ *     rationals), and the general variant on four boxes equals it on two;
  *   - and the filter decides nearly all scene-like inputs (so the comparison
  *     is not vacuous and the speed-up is real).
  * Inputs: random values over wide exponent ranges plus hard cases - plane
@@ -25,6 +30,7 @@
 
 #include "../../rtl-model/src/decode_fast.h"
 #include "../../rtl-model/src/ray_box_f64.h"
+#include "../../rtl-model/src/ray_box_ref.h"
 #include "../../rtl-model/src/ray_prep.h"
 #include "test_util.h"
 
@@ -495,7 +501,87 @@ static void test_filter_margin(void) {
     }
 }
 
+/* A finite binary32 box coordinate for the plain float slab test. */
+static float ref_coord(int wide) {
+    float v = bf(rf(0, wide ? 60 : 4, wide));
+    return isfinite(v) ? v : (rnd() & 1) ? FLT_MAX : -FLT_MAX;
+}
+
+static void test_ref_lanes(void) {
+    long n = 0, ngeneral = 0, nhit = 0, n_margin = 0;
+    for (long i = 0; i < NBOX; i++) {
+        int wide = (i & 3) == 0, M;
+        cbvh_ray ray;
+        make_ray(&ray, wide, (i & 7) == 1, 24, &M);
+        if (cbvh_f32_is_nan_or_inf(ray.tmin) || cbvh_f32_is_nan(ray.tmax)) continue;
+        int finite = 1;
+        for (int a = 0; a < 3; a++) finite &= !cbvh_f32_is_nan_or_inf(ray.o[a]) && !cbvh_f32_is_nan_or_inf(ray.d[a]);
+        if (!finite || (cbvh_f32_is_zero(ray.d[0]) && cbvh_f32_is_zero(ray.d[1]) && cbvh_f32_is_zero(ray.d[2])))
+            continue;
+        cbvh_ref_ray r;
+        cbvh_ref_prepare(&ray, &r);
+        float b4[24], b2[2][12];
+        for (int c = 0; c < 4; c++)
+            for (int a = 0; a < 3; a++) {
+                float x = ref_coord(wide), y = (rnd() & 3) ? ref_coord(wide) : x;
+                if (rnd() & 1) { /* near the ray origin, where boxes are entered and left */
+                    x = bf(ray.o[a]) + x * 0x1p-20f;
+                    y = bf(ray.o[a]) + y * 0x1p-20f;
+                }
+                float lo = x < y ? x : y, hi = x < y ? y : x;
+                b4[CBVH_REF4_AT(0, a, c)] = b2[c / 2][CBVH_REF_AT(0, a, c % 2)] = lo;
+                b4[CBVH_REF4_AT(1, a, c)] = b2[c / 2][CBVH_REF_AT(1, a, c % 2)] = hi;
+            }
+        double cull = (rnd() & 3) ? cbvh_float_of(ray.tmax) : fabs((double)ref_coord(0));
+        int h[4], g[4];
+        double t[4], u[4];
+        if (!r.general && (i & 3) == 2) { /* cull just below a box's entry: a hit only through the far margin */
+            for (int k = 0; k < 2; k++) cbvh_ref_box2_c(&r, b2[k], HUGE_VAL, h + 2 * k, t + 2 * k);
+            for (int j = 0, c0 = (int)below(4); j < 4; j++) {
+                int c = (c0 + j) & 3;
+                if (h[c] && t[c] > 0) {
+                    cull = t[c] * (1 + 0x1p-51);
+                    n_margin++;
+                    break;
+                }
+            }
+        }
+        if (r.general) {
+            ngeneral++;
+            cbvh_ref_boxw_any(&r, b4, 4, cull, g, u);
+            for (int k = 0; k < 2; k++) cbvh_ref_box2_any(&r, b2[k], cull, h + 2 * k, t + 2 * k);
+        } else {
+            for (int k = 0; k < 2; k++) cbvh_ref_box2_c(&r, b2[k], cull, h + 2 * k, t + 2 * k);
+            int m = cbvh_ref_box4(&r, b4, cull, u);
+            for (int c = 0; c < 4; c++) g[c] = m >> c & 1;
+            int h2[2];
+            double t2[2];
+            for (int k = 0; k < 2; k++) { /* the two-box lanes too */
+                cbvh_ref_box2(&r, b2[k], cull, h2, t2);
+                if ((h2[0] != h[2 * k] || h2[1] != h[2 * k + 1] || memcmp(t2, t + 2 * k, sizeof t2)) &&
+                    failures++ < 10)
+                    printf("FAIL ref lanes %ld: cbvh_ref_box2 pair %d differs from cbvh_ref_box2_c\n", i, k);
+            }
+        }
+        n++;
+        for (int c = 0; c < 4; c++) {
+            nhit += h[c];
+            if ((g[c] != h[c] || memcmp(&u[c], &t[c], sizeof u[c])) && failures++ < 10)
+                printf("FAIL ref lanes %ld box %d (%s): four-box hit %d t_lo %a, two-box hit %d t_lo %a\n", i, c,
+                       r.general ? "general" : "fast", g[c], u[c], h[c], t[c]);
+        }
+    }
+    printf("plain float slab test: %ld rays x 4 boxes (%ld general, %ld culled just below an entry), %ld box hits; "
+           "four-box and two-box lanes (%s) equal the plain C\n",
+           n, ngeneral, n_margin, nhit, CBVH_REF_SSE2 ? "SSE2" : "plain C");
+    if (n < NBOX / 2 || ngeneral < n / 20 || n_margin < n / 200 || nhit < n / 4 || nhit > 3 * n) {
+        printf("FAIL: plain float lane test inputs not varied enough\n");
+        failures++;
+    }
+}
+
 int main(void) {
+    test_ref_lanes();
     test_float_boxes();
     test_filter_margin();
     test_grid_boxes();

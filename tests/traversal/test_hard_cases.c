@@ -3,6 +3,7 @@
  * float BVHs (SAH and LBVH) and CBVHs (top-down and bottom-up, both
  * encodings, several N / M) and traces rays through all of them:
  *   - CBVH closest hit == float-BVH closest hit (prim, t, b1, b2 bits)
+ *     == the plain float traversals' (binary and 4-wide)
  *     == brute force over all triangles with the ray-triangle unit;
  *   - any-hit reports a hit iff there is one, and that hit is real;
  *   - unit-level expectations where the answer is known exactly (origin on a
@@ -15,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 #include "cbvh/unit_table.h"
 #include "test_trav_util.h"
@@ -224,6 +226,8 @@ typedef struct {
     cbvh_scene s;
     cbvh_bvh b[2];
     cbvh_fbvh fb[2]; /* b[i] laid out for the plain float traversal */
+    cbvh_qbvh q[2];   /* b[i] collapsed 4-wide ... */
+    cbvh_fqbvh fq[2]; /* ... and laid out for its plain float traversal (leaf copy for b[0]) */
     const char *bname[2];
     int nb;
     tree_cfg tr[MAX_TREES];
@@ -266,8 +270,10 @@ static int world_build(world *w, const tcfg *cfg, int ncfg, int both_builders) {
         w->bname[w->nb++] = "lbvh";
     }
     for (int bi = 0; bi < w->nb; bi++)
-        if (cbvh_fbvh_build(&w->b[bi], &w->fb[bi], err, sizeof err)) {
-            FAIL("float BVH layout: %s", err);
+        if (cbvh_fbvh_build(&w->b[bi], &w->fb[bi], err, sizeof err) ||
+            cbvh_qbvh_from_bvh(&w->b[bi], &w->q[bi], err, sizeof err) ||
+            cbvh_fqbvh_build(&w->q[bi], bi ? NULL : w->s.tris, w->s.ntris, &w->fq[bi], err, sizeof err)) {
+            FAIL("float BVH layouts: %s", err);
             return -1;
         }
     w->nt = 0;
@@ -301,6 +307,8 @@ static void world_free(world *w) {
     for (int i = 0; i < w->nt; i++) cbvh_tree_free(&w->tr[i].t);
     for (int i = 0; i < w->nb; i++) {
         cbvh_fbvh_free(&w->fb[i]);
+        cbvh_fqbvh_free(&w->fq[i]);
+        cbvh_qbvh_free(&w->q[i]);
         cbvh_bvh_free(&w->b[i]);
     }
     cbvh_scene_free(&w->s);
@@ -359,6 +367,19 @@ static cbvh_trav_hit check_ray(world *w, const cbvh_ray *r, int use_brute) {
         }
         if (!any_ok(w, r, &any, ref.hit)) {
             FAIL("plain float BVH %s any-hit %d prim %u, reference hit %d", w->bname[bi], any.hit, any.prim, ref.hit);
+            print_ray("", r);
+        }
+        /* ... and of its 4-wide collapse */
+        if (cbvh_trace_qbvh_float(&w->fq[bi], w->s.tris, r, CBVH_TRAV_CLOSEST, &h, &st) ||
+            cbvh_trace_qbvh_float(&w->fq[bi], w->s.tris, r, CBVH_TRAV_ANY, &any, &st)) {
+            FAIL("4-wide plain float %s rejected a valid ray", w->bname[bi]);
+            print_ray("", r);
+            continue;
+        }
+        w->checks++;
+        if (!same_hit(&h, &ref) || !any_ok(w, r, &any, ref.hit)) {
+            FAIL("4-wide plain float %s closest hit %d prim %u t %08X any %d != reference hit %d prim %u t %08X",
+                 w->bname[bi], h.hit, h.prim, h.t, any.hit, ref.hit, ref.prim, ref.t);
             print_ray("", r);
         }
     }
@@ -831,6 +852,13 @@ static long leak_rays(world *w, const mesh *m, long n, double inner_r, int cube)
                  i);
             print_ray("", &r);
         }
+        if (cbvh_trace_qbvh_float(&w->fq[0], w->s.tris, &r, (i & 3) ? CBVH_TRAV_ANY : CBVH_TRAV_CLOSEST, &hp, &sp) ||
+            !hp.hit) {
+            leaks++;
+            FAIL("closed_mesh_no_leaks: %s ray %ld leaked through the 4-wide plain float traversal",
+                 cube ? "cube" : "sphere", i);
+            print_ray("", &r);
+        }
         if (i % 997 == 0) check_ray(w, &r, i % (997 * 8) == 0); /* all structures; brute force on a subset */
     }
     return leaks;
@@ -1103,6 +1131,13 @@ static int case_nan_inf_rays(void) {
                 if (rc != -1 || h.hit || h.prim || h.t || ts.box_tests || ts.tri_tests || ts.nodes || ts.bytes) {
                     all_rejected = 0;
                     FAIL("nan_inf_rays: plain float BVH (mode %d) rc %d hit %d", mode, rc, h.hit);
+                    print_ray("", &r);
+                }
+                memset(&h, 0xAB, sizeof h);
+                rc = cbvh_trace_qbvh_float(&w.fq[0], w.s.tris, &r, (cbvh_trav_mode)mode, &h, &ts);
+                if (rc != -1 || h.hit || h.prim || h.t || ts.box_tests || ts.tri_tests || ts.nodes || ts.bytes) {
+                    all_rejected = 0;
+                    FAIL("nan_inf_rays: 4-wide plain float (mode %d) rc %d hit %d", mode, rc, h.hit);
                     print_ray("", &r);
                 }
                 for (int t = 0; t < w.nt; t++) {

@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 #include "cbvh/unit_table.h"
 #include "scene_load.h"
@@ -175,7 +176,21 @@ static void run_scene(const char *spec) {
         failures++;
         fb.nodes = NULL;
     }
-    long hits = 0, plain_mismatch = 0;
+    /* the 4-wide plain float traversal, with and without the leaf copy */
+    cbvh_qbvh qb;
+    cbvh_fqbvh fq[2];
+    int have_fq = !cbvh_qbvh_from_bvh(&b, &qb, err, sizeof err);
+    if (have_fq && cbvh_fqbvh_build(&qb, s.tris, s.ntris, &fq[0], err, sizeof err)) have_fq = 0;
+    if (have_fq && cbvh_fqbvh_build(&qb, NULL, 0, &fq[1], err, sizeof err)) {
+        cbvh_fqbvh_free(&fq[0]);
+        have_fq = 0;
+    }
+    if (!have_fq || !fq[0].leaf_tris || fq[1].leaf_tris || fq[0].leaf_src != s.tris) {
+        fprintf(stderr, "FAIL 4-wide layout %s: %s\n", spec, have_fq ? "leaf copy" : err);
+        failures++;
+    }
+    cbvh_trav_stats qs = {0};
+    long hits = 0, plain_mismatch = 0, wide_mismatch = 0;
     for (int i = 0; i < RAYS; i++) {
         rays[i] = box_ray(&rs, lo, hi, i, edge_on);
         cbvh_trav_hit any;
@@ -195,6 +210,17 @@ static void run_scene(const char *spec) {
             pa.hit != ref[i].hit) {
             if (plain_mismatch++ < 3) fprintf(stderr, "FAIL %s ray %d: plain float BVH != float BVH\n", spec, i);
         }
+        for (int k = 0; k < 2 && have_fq; k++) {
+            cbvh_trav_hit qh, qa;
+            cbvh_trav_stats qa1 = {0};
+            if (cbvh_trace_qbvh_float(&fq[k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &qh, k ? &qa1 : &qs) ||
+                cbvh_trace_qbvh_float(&fq[k], s.tris, &rays[i], CBVH_TRAV_ANY, &qa, &qa1) || !same_hit(&qh, &ref[i]) ||
+                qa.hit != ref[i].hit) {
+                if (wide_mismatch++ < 3)
+                    fprintf(stderr, "FAIL %s ray %d: 4-wide plain float (%s) != float BVH\n", spec, i,
+                            k ? "no leaf copy" : "leaf copy");
+            }
+        }
         if (i < BRUTE) {
             cbvh_trav_hit bf = brute(&s, &rays[i]);
             if (!same_hit(&bf, &ref[i])) {
@@ -210,7 +236,24 @@ static void run_scene(const char *spec) {
            "mismatches %ld\n",
            spec, s.ntris, (double)ps.nodes / RAYS, (double)ps.box_tests / RAYS, (double)ps.tri_tests / RAYS,
            (double)ps.bytes / RAYS, plain_mismatch);
-    failures += plain_mismatch;
+    printf("%-22s %6u tris: 4-wide plain float   closest: %.1f nodes %.1f box %.1f tri %.0f B/ray; "
+           "mismatches %ld\n",
+           spec, s.ntris, (double)qs.nodes / RAYS, (double)qs.box_tests / RAYS, (double)qs.tri_tests / RAYS,
+           (double)qs.bytes / RAYS, wide_mismatch);
+    failures += plain_mismatch + wide_mismatch;
+    /* fewer nodes than the binary tree's, as many triangles within binary64 error */
+    if (have_fq && (qs.nodes >= ps.nodes || qs.nodes < ps.nodes / 4 || qs.bytes != qs.lines * CBVH_LINE_BYTES ||
+                    qs.tri_tests > ps.tri_tests + ps.tri_tests / 100 + 10)) {
+        fprintf(stderr, "FAIL %s: 4-wide counters: %llu nodes (binary %llu), %llu tri tests (binary %llu)\n", spec,
+                (unsigned long long)qs.nodes, (unsigned long long)ps.nodes, (unsigned long long)qs.tri_tests,
+                (unsigned long long)ps.tri_tests);
+        failures++;
+    }
+    if (have_fq) {
+        cbvh_fqbvh_free(&fq[0]);
+        cbvh_fqbvh_free(&fq[1]);
+        cbvh_qbvh_free(&qb);
+    }
     /* conservative within binary64 error: at most a few more boxes than the exact M = 24 unit */
     if (ps.box_tests > fs.box_tests + fs.box_tests / 100 || ps.box_tests < fs.box_tests / 2 ||
         ps.bytes != ps.lines * CBVH_LINE_BYTES) {
@@ -397,6 +440,87 @@ static void layout_cases(void) {
         fprintf(stderr, "FAIL out-of-range child accepted by the layout (%s)\n", err);
         failures++;
     }
+}
+
+/* The 4-wide plain float layout: a one-leaf tree, a root with two leaves,
+ * QBVHs it must refuse with a reason, and the leaf copy read only for the
+ * triangle array it was made from. */
+static void wide_layout_cases(void) {
+    /* floats, not bit patterns: triangle 1 one unit below triangle 0 */
+    cbvh_tri tri[2] = {{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}, {{{0, 0, -1}, {1, 0, -1}, {0, 1, -1}}}};
+    cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(1)}, {0, CBVH_F32_SIGN, fb(-1)}, 0, CBVH_F32_POS_INF};
+    cbvh_bvh_node leaf = {{0, 0, -1}, {1, 1, 0}, {0, 0}, 0, 2};
+    uint32_t prims[2] = {1, 0};
+    cbvh_bvh b1 = {&leaf, 1, 0, prims, 2};
+    cbvh_bvh_node nodes[3] = {{{0, 0, -1}, {1, 1, 0}, {1, 2}, 0, 0},
+                              {{0, 0, -1}, {1, 1, -1}, {0, 0}, 0, 1},
+                              {{0, 0, 0}, {1, 1, 0}, {0, 0}, 1, 1}};
+    cbvh_bvh b3 = {nodes, 3, 0, prims, 2};
+    char err[256] = "";
+    for (int k = 0; k < 2; k++) {
+        cbvh_qbvh q;
+        cbvh_fqbvh f;
+        cbvh_trav_hit hw, hu;
+        cbvh_trav_stats sw = {0}, su = {0};
+        const cbvh_bvh *b = k ? &b3 : &b1;
+        int ok = !cbvh_qbvh_from_bvh(b, &q, err, sizeof err) && !cbvh_fqbvh_build(&q, tri, 2, &f, err, sizeof err);
+        /* with two leaves the farther one (triangle 1) is culled after the nearer hit */
+        ok = ok && f.nnodes == (uint32_t)k && f.leaf_tris && f.leaf_tris[0].id == 1 &&
+             !cbvh_trace_qbvh_float(&f, tri, &r, CBVH_TRAV_CLOSEST, &hw, &sw) &&
+             !cbvh_trace_bvh(b, tri, &r, 24, CBVH_TRAV_CLOSEST, &hu, &su) && hw.hit && same_hit(&hw, &hu) &&
+             hw.prim == 0 && hw.t == fb(1) && sw.tri_tests == (k ? 1u : 2u) && sw.nodes == (uint64_t)k &&
+             sw.box_tests == 1 + 2 * (uint64_t)k;
+        if (ok && k) /* the root's record: two leaf children, slots 2 and 3 empty */
+            ok = f.nodes[0].valid == 3 && f.nodes[0].child[1] == (CBVH_FQBVH_LEAF | 1u) && f.nodes[0].count[1] == 1;
+        if (ok) { /* another triangle array (triangle 0 moved): read, not the copy */
+            cbvh_tri moved[2] = {tri[0], tri[1]};
+            for (int v = 0; v < 3; v++) moved[0].v[v][2] = -0.5f;
+            ok = !cbvh_trace_qbvh_float(&f, moved, &r, CBVH_TRAV_CLOSEST, &hw, &sw) && hw.hit && hw.prim == 0 &&
+                 hw.t == fb(1.5f);
+        }
+        if (!ok) {
+            fprintf(stderr, "FAIL 4-wide layout of a %d-node tree: hit %d prim %u t %08X (%s)\n", k ? 3 : 1, hw.hit,
+                    hw.prim, hw.t, err);
+            failures++;
+        }
+        cbvh_fqbvh_free(&f);
+        cbvh_qbvh_free(&q);
+    }
+    /* hand-made QBVHs: a child before its parent, a leaf past the IDs, a leaf too large */
+    float bmin[3][4] = {{0}}, bmax[3][4] = {{1, 1, 1, 0}, {1, 1, 1, 0}, {1, 1, 1, 0}};
+    uint32_t first[3] = {1, 0, 1}, count[3] = {2, CBVH_QBVH_LEAF | 1, CBVH_QBVH_LEAF | 1};
+    static uint32_t many[70000];
+    cbvh_qbvh q = {3, bmin, bmax, first, count, many, 2, 1, 1};
+    struct {
+        uint32_t node, first, count;
+        const char *why;
+    } bad[] = {{0, 0, 2, "bad children"},
+               {0, 2, 2, "bad children"},
+               {0, 1, 1, "bad children"},
+               {2, 2, CBVH_QBVH_LEAF | 1, "out of bounds"},
+               {2, 0, CBVH_QBVH_LEAF, "out of bounds"},
+               {2, 0, CBVH_QBVH_LEAF | 65536, "above 65535"}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        uint32_t f0 = first[bad[i].node], c0 = count[bad[i].node];
+        first[bad[i].node] = bad[i].first;
+        count[bad[i].node] = bad[i].count;
+        q.nprims = bad[i].count == (CBVH_QBVH_LEAF | 65536) ? 70000 : 2;
+        cbvh_fqbvh f;
+        err[0] = 0;
+        if (cbvh_fqbvh_build(&q, NULL, 0, &f, err, sizeof err) != -1 || !strstr(err, bad[i].why) || f.nodes) {
+            fprintf(stderr, "FAIL 4-wide layout accepted bad QBVH %zu (%s)\n", i, err);
+            failures++;
+        }
+        first[bad[i].node] = f0;
+        count[bad[i].node] = c0;
+    }
+    q.nprims = 2;
+    cbvh_fqbvh f;
+    if (cbvh_fqbvh_build(&q, NULL, 0, &f, err, sizeof err) || f.nnodes != 1 || f.leaf_tris) {
+        fprintf(stderr, "FAIL 4-wide layout refused a good QBVH (%s)\n", err);
+        failures++;
+    }
+    cbvh_fqbvh_free(&f);
 }
 
 /* A one-pair CBVH over [0, 1]^3 (N = 6, relative codes): child 0 with the
@@ -598,6 +722,7 @@ static void memory_map(void) {
 int main(void) {
     bad_rays();
     layout_cases();
+    wide_layout_cases();
     cyclic_cbvh();
     decoded_malformed();
     decoded_leaves();

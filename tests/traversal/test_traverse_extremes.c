@@ -12,7 +12,8 @@
  *          direction components +0/-0, bounded and unbounded tmax; closest
  *          and any hit; box unit M = 24, 8 and 3.
  * The traversals compared: float BVH through the units, the plain float
- * traversal, the CBVH (each tree), the QBVH (each stack kind), the
+ * traversal and its 4-wide variant over the QBVH (half with the leaf copy),
+ * the CBVH (each tree), the QBVH (each stack kind), the
  * stackless traversal lists (1, 2, 6 and 8 lists; seed 004); and the CBVH
  * decoded once (docs/traversal.md §12) against the CBVH's per-visit
  * traversal: return value, hit and every counter.  Here planes are often not
@@ -188,6 +189,9 @@ static void run_soup(int k, long hits[KINDS], long rays[KINDS]) {
         CHECK(have_fb, "%s: float layout: %s", kind_name[k], err);
         int have_q = !cbvh_qbvh_from_bvh(&b, &q, err, sizeof err);
         CHECK(have_q, "%s: QBVH: %s", kind_name[k], err);
+        cbvh_fqbvh fq; /* the 4-wide plain float layout, with the leaf copy for one builder */
+        int have_fq = have_q && !cbvh_fqbvh_build(&q, builder ? s.tris : NULL, s.ntris, &fq, err, sizeof err);
+        CHECK(have_fq, "%s: 4-wide float layout: %s", kind_name[k], err);
         cbvh_tree t[2][TREES];
         cbvh_cbvh_decoded dt[2][TREES];
         int have_t[2][TREES];
@@ -239,6 +243,10 @@ static void run_soup(int k, long hits[KINDS], long rays[KINDS]) {
                     rc = cbvh_trace_bvh_float(&fb, s.tris, &r, md, &got, &st);
                     expect(kind_name[k], "plain float BVH", mode, &want, rc, &got);
                 }
+                if (have_fq) {
+                    rc = cbvh_trace_qbvh_float(&fq, s.tris, &r, md, &got, &st);
+                    expect(kind_name[k], "4-wide plain float", mode, &want, rc, &got);
+                }
                 for (int kind = CBVH_QSTACK_COMPRESSED; have_q && kind <= CBVH_QSTACK_PLAIN; kind++) {
                     snprintf(what, sizeof what, "QBVH stack kind %d", kind);
                     rc = cbvh_trace_qbvh(&q, s.tris, &r, 24, md, (cbvh_qstack_kind)kind, &got, &st);
@@ -269,6 +277,7 @@ static void run_soup(int k, long hits[KINDS], long rays[KINDS]) {
                     cbvh_cbvh_decoded_free(&dt[bu][j]);
                     cbvh_tree_free(&t[bu][j]);
                 }
+        if (have_fq) cbvh_fqbvh_free(&fq);
         if (have_q) cbvh_qbvh_free(&q);
         if (have_fb) cbvh_fbvh_free(&fb);
         cbvh_bvh_free(&b);

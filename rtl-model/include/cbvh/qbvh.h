@@ -98,4 +98,47 @@ int cbvh_qbvh_stack_check(const cbvh_qbvh *q, cbvh_qstack_kind kind, char *err, 
 int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
                     cbvh_trav_mode mode, cbvh_qstack_kind kind, cbvh_trav_hit *hit, cbvh_trav_stats *st);
 
+/* ---- plain floating-point traversal of the QBVH (rtl-model/src/traverse_qbvh_float.c)
+ * What a software renderer runs on the float BVH collapsed 4-wide
+ * (docs/traversal.md §13): one 128-byte record per inner node with its
+ * children's four boxes as [lower, upper][axis][child] binary32, tested by
+ * the conservative binary64 slab test of the plain float traversal
+ * (cbvh_trace_bvh_float; four lanes, never a false miss), triangles by the
+ * ray-triangle unit.  Same hit rules as cbvh_trace_bvh, so the closest hit
+ * equals it bit for bit (ties go to the lowest primitive ID whatever the
+ * order) and the any-hit flag too. */
+#define CBVH_FQBVH_LEAF 0x80000000u /* child entry of a leaf: | its first index into prims */
+typedef struct {
+    float pl[24];       /* plane (0 lower, 1 upper) of axis a of child c at ((plane * 3) + a) * 4 + c */
+    uint32_t child[4];  /* inner child: record index; leaf: CBVH_FQBVH_LEAF | first */
+    uint16_t count[4];  /* leaf child: its primitive count (1 .. 65535); inner: 0 */
+    uint32_t valid;     /* bit c: slot c holds a child (2 to 4 do) */
+    uint32_t pad;
+} cbvh_fqbvh_node;
+
+typedef struct {
+    const cbvh_qbvh *q;     /* not owned */
+    cbvh_fqbvh_node *nodes; /* 64-byte aligned, one per inner node, breadth-first */
+    uint32_t nnodes;
+    uint32_t root, root_count; /* the root as a child entry */
+    float root_box[12];        /* the root's box as child 0 and 1 of a pair (cbvh_ref_box2) */
+    const cbvh_tri *leaf_src;  /* the triangles copied into leaf_tris, or NULL */
+    cbvh_cbvh_dtri *leaf_tris; /* q->nprims records in prims order: a leaf's triangles side by side */
+} cbvh_fqbvh;
+
+/* 0, or -1 with a one-line reason (out of memory, a leaf of more than 65535
+ * primitives, more than 2^31 nodes).  f->q points to q, which must outlive
+ * f.  With tris (ntris triangles), each leaf's triangles are also copied
+ * next to their IDs (q->nprims * 40 bytes); tracing reads the copy only
+ * when given the same tris pointer.  NULL: no copy. */
+int cbvh_fqbvh_build(const cbvh_qbvh *q, const cbvh_tri *tris, uint32_t ntris, cbvh_fqbvh *out, char *err,
+                     size_t errlen);
+void cbvh_fqbvh_free(cbvh_fqbvh *f);
+
+/* Stats: nodes = inner nodes visited, box tests = their children (2..4),
+ * 128 bytes (two lines) per node; 0, or -1 (stack overflow, a ray the units
+ * reject). */
+int cbvh_trace_qbvh_float(const cbvh_fqbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
+                          cbvh_trav_hit *hit, cbvh_trav_stats *st);
+
 #endif
