@@ -57,6 +57,7 @@ typedef struct {
     int near_hi[3]; /* d_a < 0: the near plane is the upper one */
     int near_at[3], far_at[3]; /* index of axis a's near / far plane of box 0 in a [2][3][2] plane array */
     int ok;         /* the filter applies to this ray (finite, no zero d_a, valid M) */
+    _Alignas(16) double o2[3][2], inv2[3][2]; /* o, inv twice: an SSE2 register's two lanes */
 } cbvh_rbf_ray;
 
 static inline double cbvh_rbf_f32(cbvh_f32 b) { return (double)cbvh_float_of(b); }
@@ -80,7 +81,7 @@ static inline double cbvh_rbf_from_bits(uint64_t b) {
 static inline double cbvh_rbf_pow2(int e) { return cbvh_rbf_from_bits((uint64_t)(e + 1023) << 52); }
 
 static inline void cbvh_rbf_prepare(const cbvh_ray *ray, int M, cbvh_rbf_ray *p) {
-    memset(p, 0, sizeof *p);
+    p->mask = 0; /* every other field is set below */
     p->ok = CBVH_RBF_ENABLED && M >= CBVH_MANT_MIN && M <= CBVH_MANT_MAX && !cbvh_f32_is_nan_or_inf(ray->tmin);
     for (int a = 0; a < 3; a++) {
         if (cbvh_f32_is_nan_or_inf(ray->o[a]) || cbvh_f32_is_nan_or_inf(ray->d[a]) || cbvh_f32_is_zero(ray->d[a]))
@@ -91,6 +92,8 @@ static inline void cbvh_rbf_prepare(const cbvh_ray *ray, int M, cbvh_rbf_ray *p)
         p->near_hi[a] = d < 0;
         p->near_at[a] = 6 * (d < 0) + 2 * a; /* an index, not a branch per axis and box pair */
         p->far_at[a] = 6 * !(d < 0) + 2 * a;
+        p->o2[a][0] = p->o2[a][1] = p->o[a];
+        p->inv2[a][0] = p->inv2[a][1] = p->inv[a];
     }
     p->tmin = cbvh_rbf_f32(ray->tmin);
     if (M >= CBVH_MANT_MIN && M <= CBVH_MANT_MAX) p->mask = (UINT64_C(1) << (53 - M)) - 1u;
@@ -222,7 +225,7 @@ static inline int cbvh_rbf_box2_core(const cbvh_rbf_ray *p, double tmax, const v
                 vn = _mm_loadu_pd(d + p->near_at[a]);
                 vf = _mm_loadu_pd(d + p->far_at[a]);
             }
-            __m128d o = _mm_set1_pd(p->o[a]), inv = _mm_set1_pd(p->inv[a]);
+            __m128d o = _mm_load_pd(p->o2[a]), inv = _mm_load_pd(p->inv2[a]);
             vnh = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(vn, o), inv), vnh);
             vfh = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(vf, o), inv), vfh);
         }

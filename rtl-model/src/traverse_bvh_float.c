@@ -160,7 +160,6 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     ts.s.nodes += nodes;
     ts.s.box_tests += 2 * nodes;
     ts.s.lines += nodes;
-    ts.s.bytes += nodes * CBVH_LINE_BYTES;
     ts.s.max_stack = max_stack;
     trav_finish(&ts, hit, st);
     return 0;

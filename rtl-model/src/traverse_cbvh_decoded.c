@@ -179,6 +179,7 @@ int cbvh_cbvh_decode(const cbvh_tree *t, cbvh_cbvh_decoded *out, char *err, size
         cbvh_cbvh_dnode *rec = &out->nodes[e.pair];
         ok = decode_pair(t, e.pair, &e.ctx, rec, &out->rel[e.pair], &out->wide[out->nwide], stack, &sp);
         if (ok && (rec->flags & (CBVH_DEC_EXACT | CBVH_DEC_F32)) == CBVH_DEC_EXACT) rec->wide = out->nwide++;
+        if (cbvh_lines_touched((uint64_t)e.pair * t->pair_bytes, t->pair_bytes) == 2) rec->flags |= CBVH_DEC_2LINES;
     }
     free(stack);
     free(seen);
@@ -209,26 +210,35 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
     double cull_d = cbvh_rbf_f32(cull);
     cbvh_box_result r;
     double rtn;
+    /* The entry being visited, cur, is kept out of the stack: a pair's nearer
+     * hit child becomes cur instead of being pushed and popped at once.
+     * Order, culling (the pop's t_near > cull check, on cur too), the
+     * overflow check and max_stack (cur counted) are those of pushing it. */
+    entry cur = {t->root_pair, 0, 0};
+    int have = 0;
     if (trav_cbvh_root(&ts, &fp, t, cull, &rtn)) {
-        stack[0].leaf = 0;
-        stack[0].ptr = t->root_pair;
-        stack[0].t_near = rtn;
-        sp = 1;
+        cur.t_near = rtn;
+        have = 1;
         max_stack = 1;
     }
-    while (sp > 0) {
-        entry *e = &stack[--sp];
-        if (e->t_near > cull_d) continue;
-        if (e->leaf) {
-            if (lt ? leaf_copy(&ts, lt, t->nids, e->ptr, &cull, &cull_d) : trav_cbvh_leaf(&ts, t, e->ptr, &cull, &cull_d))
+    for (;;) {
+        if (!have) {
+            if (sp == 0) break;
+            /* cppcheck-suppress uninitvar ; entries below sp were pushed */
+            cur = stack[--sp];
+        }
+        have = 0;
+        if (cur.t_near > cull_d) continue;
+        if (cur.leaf) {
+            if (lt ? leaf_copy(&ts, lt, t->nids, cur.ptr, &cull, &cull_d) : trav_cbvh_leaf(&ts, t, cur.ptr, &cull, &cull_d))
                 break;
             continue;
         }
-        uint32_t p = e->ptr;
+        uint32_t p = cur.ptr;
         ts.s.nodes++; /* the decode visited each pair once: no cycle, no pointer out of range */
-        trav_fetch(&ts, (uint64_t)p * t->pair_bytes, t->pair_bytes);
         const cbvh_cbvh_dnode *rec = &d->nodes[p];
         uint32_t fl = rec->flags;
+        ts.s.lines += 1u + !!(fl & CBVH_DEC_2LINES); /* trav_fetch of the pair's bytes */
         for (int c = 0; c < 2; c++) { /* start the children's loads before their box tests */
             uint32_t q = rec->child[c];
             if (fl & (CBVH_DEC_EMPTY0 << c)) continue;
@@ -270,16 +280,19 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
             tn[c] = cbvh_rbf_f32(r.t_near);
         }
         if (sp + h[0] + h[1] > CBVH_TRAV_STACK) return -1;
-        int first = h[0] && h[1] && tn[1] < tn[0];
-        for (int k = 1; k >= 0; k--) {
-            int c = k ? 1 - first : first;
-            if (!h[c]) continue;
+        if (!(h[0] | h[1])) continue;
+        int near = h[0] && h[1] ? tn[1] < tn[0] : h[1]; /* the nearer hit child (ties: child 0) */
+        if (h[0] & h[1]) { /* the farther one pushed */
             entry *ne = &stack[sp++];
-            ne->leaf = (fl & (CBVH_DEC_LEAF0 << c)) != 0;
-            ne->ptr = rec->child[c];
-            ne->t_near = tn[c];
+            ne->leaf = (fl & (CBVH_DEC_LEAF0 << (1 - near))) != 0;
+            ne->ptr = rec->child[1 - near];
+            ne->t_near = tn[1 - near];
         }
-        if ((uint32_t)sp > max_stack) max_stack = (uint32_t)sp;
+        cur.leaf = (fl & (CBVH_DEC_LEAF0 << near)) != 0;
+        cur.ptr = rec->child[near];
+        cur.t_near = tn[near];
+        have = 1;
+        if ((uint32_t)sp + 1u > max_stack) max_stack = (uint32_t)sp + 1u;
     }
     ts.s.max_stack = max_stack;
     trav_finish(&ts, hit, st);

@@ -61,10 +61,9 @@ static inline const cbvh_rb_ray *trav_prep(trav_state *ts) {
     return &ts->prep;
 }
 
+/* Lines read; bytes are whole lines, counted once at trav_finish. */
 static inline void trav_fetch(trav_state *ts, uint64_t addr, uint64_t size) {
-    uint64_t n = cbvh_lines_touched(addr, size);
-    ts->s.lines += n;
-    ts->s.bytes += n * CBVH_LINE_BYTES;
+    ts->s.lines += cbvh_lines_touched(addr, size);
 }
 
 /* Upper t for box culling: a triangle is accepted when RD(t) <= X (X = ray
@@ -117,7 +116,7 @@ static inline void trav_finish(const trav_state *ts, cbvh_trav_hit *hit, cbvh_tr
     st->box_tests += ts->s.box_tests;
     st->tri_tests += ts->s.tri_tests;
     st->lines += ts->s.lines;
-    st->bytes += ts->s.bytes;
+    st->bytes += ts->s.lines * CBVH_LINE_BYTES;
     if (ts->s.max_stack > st->max_stack) st->max_stack = ts->s.max_stack;
 }
 

@@ -153,7 +153,7 @@ finish:
     st->box_tests += qs.s.box_tests;
     st->tri_tests += qs.s.tri_tests;
     st->lines += qs.s.lines;
-    st->bytes += qs.s.bytes;
+    st->bytes += qs.s.lines * CBVH_LINE_BYTES;
     if (qs.s.max_stack > st->max_stack) st->max_stack = qs.s.max_stack;
     st->qstack_pushes += qs.s.qstack_pushes;
     st->qstack_pops += qs.s.qstack_pops;

@@ -210,7 +210,6 @@ int cbvh_trace_qbvh_float(const cbvh_fqbvh *f, const cbvh_tri *tris, const cbvh_
     ts.s.nodes += nodes;
     ts.s.box_tests += boxes;
     ts.s.lines += 2 * nodes;
-    ts.s.bytes += nodes * sizeof(cbvh_fqbvh_node);
     ts.s.max_stack = max_stack;
     trav_finish(&ts, hit, st);
     return 0;

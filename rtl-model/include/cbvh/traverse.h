@@ -108,6 +108,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
 #define CBVH_DEC_EMPTY0 4u /* ... child 0 empty (child 1: the bit doubled) */
 #define CBVH_DEC_EXACT 16u /* every plane exact in binary64: the binary64 box filter applies */
 #define CBVH_DEC_F32 32u   /* with EXACT: every plane exact in binary32 too, kept in pl */
+#define CBVH_DEC_2LINES 64u /* the pair's bytes in the CBVH's memory image span two lines (the counters) */
 typedef struct {
     float pl[2][3][2];        /* [lower, upper][axis][child] with F32; an empty child's box is a dummy; else 0 */
     uint32_t child[2];        /* pointer: a pair index, or a leaf's first ID */
