@@ -486,6 +486,42 @@ static void wide_layout_cases(void) {
         cbvh_fqbvh_free(&f);
         cbvh_qbvh_free(&q);
     }
+    /* A chain of 4-child nodes, all boxes [0, 1]^2 x [-1, 0]: each level defers its three leaves
+     * (ties: slot 0, the next level, first), so the stack grows by 3 a level: depth 20 fits
+     * (max_stack 3 * 20 + 1, 20 nodes), depth 100 overflows (-1); a ray missing the root
+     * leaves max_stack 0. */
+    for (int depth = 20; depth <= 100; depth += 80) {
+        uint32_t nn = 1 + 4 * (uint32_t)depth, cf[401], cc[401], pz = 0;
+        float cmin[401][4], cmax[401][4];
+        for (uint32_t i = 0; i < nn; i++) {
+            float lo4[4] = {0, 0, -1, 0}, hi4[4] = {1, 1, 0, 0};
+            memcpy(cmin[i], lo4, sizeof lo4);
+            memcpy(cmax[i], hi4, sizeof hi4);
+            cf[i] = 0;
+            cc[i] = CBVH_QBVH_LEAF | 1;
+        }
+        for (int j = 0; j < depth; j++) { /* level j's inner node, its children at 1 + 4j .. */
+            uint32_t in = j ? 1 + 4 * (uint32_t)(j - 1) : 0;
+            cf[in] = 1 + 4 * (uint32_t)j;
+            cc[in] = 4;
+        }
+        cbvh_qbvh cq = {nn, cmin, cmax, cf, cc, &pz, 1, 0, 0};
+        cbvh_fqbvh cfq;
+        cbvh_trav_hit ch;
+        cbvh_trav_stats cs = {0}, cm = {0};
+        cbvh_ray miss = r;
+        miss.o[0] = fb(5.0f); /* beside the root box */
+        int built = !cbvh_fqbvh_build(&cq, NULL, 0, &cfq, err, sizeof err);
+        int rc = built ? cbvh_trace_qbvh_float(&cfq, tri, &r, CBVH_TRAV_CLOSEST, &ch, &cs) : -9;
+        int rm = built ? cbvh_trace_qbvh_float(&cfq, tri, &miss, CBVH_TRAV_CLOSEST, &ch, &cm) : -9;
+        int ok = depth == 20 ? rc == 0 && cs.max_stack == 61 && cs.nodes == 20 : rc == -1;
+        if (!ok || rm != 0 || ch.hit || cm.max_stack != 0 || cm.box_tests != 1) {
+            fprintf(stderr, "FAIL 4-wide chain depth %d: rc %d max_stack %u nodes %llu; miss rc %d max_stack %u (%s)\n",
+                    depth, rc, cs.max_stack, (unsigned long long)cs.nodes, rm, cm.max_stack, err);
+            failures++;
+        }
+        if (built) cbvh_fqbvh_free(&cfq);
+    }
     /* hand-made QBVHs: a child before its parent, a leaf past the IDs, a leaf too large */
     float bmin[3][4] = {{0}}, bmax[3][4] = {{1, 1, 1, 0}, {1, 1, 1, 0}, {1, 1, 1, 0}};
     uint32_t first[3] = {1, 0, 1}, count[3] = {2, CBVH_QBVH_LEAF | 1, CBVH_QBVH_LEAF | 1};
