@@ -112,18 +112,15 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     int sp = 0;
     uint32_t max_stack = 0;
     uint64_t nodes = 0;
-    /* the same culling bound as cbvh_trace_bvh: no acceptable triangle culled */
-    double cull = cbvh_float_of(trav_box_tmax(&ts));
+    double cull;
+    int have = plain_root(&ts, &r, f->root_box, &cull);
     int h[2];
     double tl[2];
-    ts.s.box_tests++;
-    cbvh_ref_box2_for(&r, f->root_box, cull, h, tl);
     /* the node being visited is kept out of the stack (e, cnt): a node's
      * nearer hit child is visited next without a push and a pop, the farther
      * one pushed.  Visiting order, culling and max_stack are those of pushing
      * both (farther first) and popping: max_stack counts the visited entry. */
     uint32_t e = f->root, cnt = f->root_count;
-    int have = h[0];
     if (have) max_stack = 1;
     while (have) {
         if (e & CBVH_FBVH_LEAF) {

@@ -5,6 +5,9 @@
 
 #include <stdint.h>
 
+#include "ray_box_ref.h"
+#include "traverse_common.h"
+
 /* A child entry as in the records (a record index, or a leaf flag | first
  * and the count) and the lower bound of its entry t. */
 typedef struct {
@@ -30,6 +33,18 @@ static inline int plain_pop(const plain_entry *stack, int *sp, double cull, uint
         return 1;
     }
     return 0;
+}
+
+/* The root's box test (one box test counted) with §5's culling bound, the
+ * same for every plain traversal: 1 if the ray may meet the root.  *cull
+ * receives the bound. */
+static inline int plain_root(trav_state *ts, const cbvh_ref_ray *r, const float root_box[12], double *cull) {
+    int h[2];
+    double tl[2];
+    *cull = cbvh_float_of(trav_box_tmax(ts)); /* no acceptable triangle culled */
+    ts->s.box_tests++;
+    cbvh_ref_box2_for(r, root_box, *cull, h, tl);
+    return h[0];
 }
 
 #endif

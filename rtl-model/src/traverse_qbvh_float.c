@@ -126,17 +126,13 @@ int cbvh_trace_qbvh_float(const cbvh_fqbvh *f, const cbvh_tri *tris, const cbvh_
     int sp = 0;
     uint32_t max_stack = 0;
     uint64_t nodes = 0, boxes = 0;
-    /* the same culling bound as cbvh_trace_bvh: no acceptable triangle culled */
-    double cull = cbvh_float_of(trav_box_tmax(&ts));
-    int h[2];
+    double cull;
+    int have = plain_root(&ts, &r, f->root_box, &cull);
     double tl[4];
-    ts.s.box_tests++;
-    cbvh_ref_box2_for(&r, f->root_box, cull, h, tl);
     /* As in cbvh_trace_bvh_float: the nearest hit child is visited next
      * without a push, the others pushed farthest first; max_stack counts
      * the visited entry. */
     uint32_t e = f->root, cnt = f->root_count;
-    int have = h[0];
     if (have) max_stack = 1;
     while (have) {
         if (e & CBVH_FQBVH_LEAF) {
