@@ -60,6 +60,9 @@ typedef struct {
     double dx, dy, dz, ox, oy, oz;
 } cbvh_tri_ray;
 void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p);
+/* The same for a ray already known valid (finite o and d, d != 0: e.g. one
+ * cbvh_rb_ray_status accepted), without checking it again: ok = 1. */
+void cbvh_tri_ray_prepare_valid(const cbvh_ray *ray, cbvh_tri_ray *p);
 /* cbvh_ray_triangle with the ray prepared (same outputs and status). */
 uint32_t cbvh_ray_triangle_prepared(const cbvh_tri_ray *p, const cbvh_ray *ray, const cbvh_f32 v0[3],
                                     const cbvh_f32 v1[3], const cbvh_f32 v2[3], cbvh_tri_result *out);

@@ -164,7 +164,12 @@ static cbvh_f32 quot_trunc(double a, double b, double ra, double rb) {
 void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p) {
     int bad = 0;
     for (int a = 0; a < 3; a++) bad |= cbvh_f32_is_nan_or_inf(ray->o[a]) | cbvh_f32_is_nan_or_inf(ray->d[a]);
+    cbvh_tri_ray_prepare_valid(ray, p);
     p->ok = !bad && !(cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]));
+}
+
+void cbvh_tri_ray_prepare_valid(const cbvh_ray *ray, cbvh_tri_ray *p) {
+    p->ok = 1;
     int kz = 0;
     for (int a = 1; a < 3; a++)
         if ((ray->d[a] & ~CBVH_F32_SIGN) > (ray->d[kz] & ~CBVH_F32_SIGN)) kz = a;

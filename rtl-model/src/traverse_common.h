@@ -23,10 +23,11 @@ typedef struct {
     int done; /* any-hit found */
 } trav_state;
 
-/* The ray, and its preparation for the triangle unit (every traversal). */
+/* The ray, and its preparation for the triangle unit (every traversal; the
+ * ray has passed cbvh_rb_ray_status, so its o and d are finite, d != 0). */
 static inline void trav_set_ray(trav_state *ts, const cbvh_ray *ray) {
     ts->ray = ray;
-    cbvh_tri_ray_prepare(ray, &ts->tprep);
+    cbvh_tri_ray_prepare_valid(ray, &ts->tprep);
 }
 
 static inline uint64_t trav_align(uint64_t a) { return (a + CBVH_LINE_BYTES - 1) / CBVH_LINE_BYTES * CBVH_LINE_BYTES; }
