@@ -13,18 +13,6 @@
 #include "grid.h"
 #include "ray_prep.h"
 
-static int ray_bad(const cbvh_ray *ray) {
-    for (int a = 0; a < 3; a++)
-        if (cbvh_f32_is_nan_or_inf(ray->o[a]) || cbvh_f32_is_nan_or_inf(ray->d[a])) return 1;
-    if (cbvh_f32_is_nan_or_inf(ray->tmin)) return 1;
-    if (cbvh_f32_is_nan(ray->tmax) || ray->tmax == CBVH_F32_NEG_INF) return 1;
-    return 0;
-}
-
-static int dir_zero(const cbvh_ray *ray) {
-    return cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]);
-}
-
 /* The slab test of three axes, planes lo[a] <= hi[a] exact. */
 static void slabs(const cbvh_ray *ray, int M, const cbvh_xw lo[3], const cbvh_xw hi[3], cbvh_box_result *out) {
     int64_t kn = cbvh_f32_key(ray->tmin), kf = cbvh_f32_key(ray->tmax);
@@ -60,19 +48,9 @@ static void slabs(const cbvh_ray *ray, int M, const cbvh_xw lo[3], const cbvh_xw
     out->t_far = cbvh_f32_is_zero(tf) ? 0 : tf;
 }
 
-static uint32_t check_common(const cbvh_ray *ray, int M) {
-    uint32_t st = 0;
-    if (M < CBVH_MANT_MIN || M > CBVH_MANT_MAX) st |= CBVH_ST_BAD_PARAM;
-    if (ray_bad(ray)) st |= CBVH_ST_NAN_INF;
-    else if (dir_zero(ray)) st |= CBVH_ST_ZERO_DIR;
-    return st;
-}
-
-uint32_t cbvh_rb_ray_status(const cbvh_ray *ray, int M) { return check_common(ray, M); }
-
 uint32_t cbvh_ray_box_exact_only(const cbvh_ray *ray, int M, const cbvh_grid_axis axis[3], cbvh_box_result *out) {
     memset(out, 0, sizeof *out);
-    uint32_t st = check_common(ray, M);
+    uint32_t st = cbvh_rb_ray_status(ray, M);
     for (int a = 0; a < 3; a++) {
         const cbvh_grid_axis *g = &axis[a];
         if (cbvh_f32_is_nan(g->u) || g->u == CBVH_F32_POS_INF) st |= CBVH_ST_NAN_INF;
@@ -98,7 +76,7 @@ uint32_t cbvh_ray_box_exact_only(const cbvh_ray *ray, int M, const cbvh_grid_axi
 uint32_t cbvh_ray_box_float_exact_only(const cbvh_ray *ray, int M, const cbvh_f32 blo[3], const cbvh_f32 bhi[3],
                                        cbvh_box_result *out) {
     memset(out, 0, sizeof *out);
-    uint32_t st = check_common(ray, M);
+    uint32_t st = cbvh_rb_ray_status(ray, M);
     for (int a = 0; a < 3; a++) {
         if (cbvh_f32_is_nan_or_inf(blo[a]) || cbvh_f32_is_nan_or_inf(bhi[a])) st |= CBVH_ST_NAN_INF;
         else if (cbvh_f32_cmp(blo[a], bhi[a]) > 0) st |= CBVH_ST_INVERTED;
@@ -237,7 +215,7 @@ void cbvh_rb_prepare(const cbvh_ray *ray, cbvh_rb_ray *p) {
     p->ray = ray;
     cbvh_ray probe = *ray;
     probe.tmax = 0; /* tmax is checked per call */
-    p->status = ray_bad(&probe) ? CBVH_ST_NAN_INF : dir_zero(ray) ? CBVH_ST_ZERO_DIR : 0;
+    p->status = cbvh_rb_ray_status(&probe, CBVH_MANT_MAX); /* NAN_INF or ZERO_DIR; M is checked per call */
     if (p->status) return;
 #ifdef __SIZEOF_INT128__
     for (int a = 0; a < 3; a++) {

@@ -34,8 +34,18 @@ void cbvh_rb_prepare(const cbvh_ray *ray, cbvh_rb_ray *p);
 
 /* The status bits the box unit gives for the ray and M alone (BAD_PARAM,
  * NAN_INF, ZERO_DIR): the unit returns at least these for every box, and no
- * other bit for a valid box.  The traversals' ray check. */
-uint32_t cbvh_rb_ray_status(const cbvh_ray *ray, int M);
+ * other bit for a valid box.  The traversals' ray check (inline: one per ray,
+ * a tenth of a small scene's ray). */
+static inline uint32_t cbvh_rb_ray_status(const cbvh_ray *ray, int M) {
+    uint32_t st = M < CBVH_MANT_MIN || M > CBVH_MANT_MAX ? CBVH_ST_BAD_PARAM : 0;
+    int bad = cbvh_f32_is_nan_or_inf(ray->tmin) | cbvh_f32_is_nan(ray->tmax) | (ray->tmax == CBVH_F32_NEG_INF);
+    cbvh_f32 dmag = 0; /* zero iff every d_a is +-0 */
+    for (int a = 0; a < 3; a++) {
+        bad |= cbvh_f32_is_nan_or_inf(ray->o[a]) | cbvh_f32_is_nan_or_inf(ray->d[a]);
+        dmag |= ray->d[a] & ~CBVH_F32_SIGN;
+    }
+    return st | (bad ? CBVH_ST_NAN_INF : dmag == 0 ? CBVH_ST_ZERO_DIR : 0);
+}
 
 /* cbvh_ray_box / cbvh_ray_box_float for a prepared ray with tmax replaced by
  * `tmax` (the traversal's culling bound); same outputs and status bit for bit. */
