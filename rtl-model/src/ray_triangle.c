@@ -201,31 +201,56 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     double adx = fabs(dx), ady = fabs(dy), adz = fabs(dz);
     double ox = p->ox, oy = p->oy, oz = p->oz;
     const cbvh_f32 *v[3] = {v0, v1, v2};
-    /* X, Y, Z and bounds eX, eY, eZ on their errors (see the top of the
-     * section): |X^ - X| <= 3.0002u (|px^ dz| + |pz^ dx|) < 4u (...)^ */
-    double X[3], Y[3], Z[3], eX[3], eY[3], eZ[3];
+    /* X, Y and the largest |P^| component, Pm */
+    double px[3], py[3], pz[3], X[3], Y[3], Pm = 0;
     for (int i = 0; i < 3; i++) {
-        double vx = f32d(v[i][kx]), vy = f32d(v[i][ky]), vz = f32d(v[i][kz]);
-        double px = vx - ox, py = vy - oy, pz = vz - oz;
-        double apz = fabs(pz);
-        X[i] = px * dz - pz * dx;
-        Y[i] = py * dz - pz * dy;
-        Z[i] = pz;
-        eX[i] = 4.0 * u * (fabs(px) * adz + apz * adx);
-        eY[i] = 4.0 * u * (fabs(py) * adz + apz * ady);
+        px[i] = f32d(v[i][kx]) - ox;
+        py[i] = f32d(v[i][ky]) - oy;
+        pz[i] = f32d(v[i][kz]) - oz;
+        X[i] = px[i] * dz - pz[i] * dx;
+        Y[i] = py[i] * dz - pz[i] * dy;
+        double ax = fabs(px[i]), ay = fabs(py[i]), az = fabs(pz[i]);
+        Pm = ax > Pm ? ax : Pm;
+        Pm = ay > Pm ? ay : Pm;
+        Pm = az > Pm ? az : Pm;
+    }
+    double E[3], a[3], c[3];
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        a[i] = X[k] * Y[j];
+        c[i] = Y[k] * X[j];
+        E[i] = a[i] - c[i];
+    }
+    /* Quick miss (most misses end here): one bound for all three E_i.  With
+     * s = Pm |d_z| (|d_z| is the largest |d|): e_X, e_Y <= 3.0002u 2s and
+     * |X^|, |Y^| <= 2s (1 + u)^2, so every e_E <= 4 |X^| e_Y + 2 e_X e_Y +
+     * 2.0001u (|a| + |c|) < 64.01u s^2; B = 2^-46 s^2 = 128u s^2 stays above
+     * that after its own two roundings (u s^2 >= 2^-649: no underflow).  E_i
+     * of both signs beyond B: a miss, without the per-vertex bounds below,
+     * which decide the rest (tighter where a triangle is small next to its
+     * distance from the origin). */
+    double s = Pm * adz, B = 0x1p-46 * s * s;
+    int pos = (E[0] > B) | (E[1] > B) | (E[2] > B), neg = (E[0] < -B) | (E[1] < -B) | (E[2] < -B);
+    if (pos & neg) return 1;
+    /* Bounds eX, eY, eZ on the errors of X, Y, Z = P_z (see the top of the
+     * section): |X^ - X| <= 3.0002u (|px^ dz| + |pz^ dx|) < 4u (...)^ */
+    double Z[3], eX[3], eY[3], eZ[3];
+    for (int i = 0; i < 3; i++) {
+        double apz = fabs(pz[i]);
+        Z[i] = pz[i];
+        eX[i] = 4.0 * u * (fabs(px[i]) * adz + apz * adx);
+        eY[i] = 4.0 * u * (fabs(py[i]) * adz + apz * ady);
         eZ[i] = 1.0001 * u * apz;
     }
     /* E_i = X_k Y_j - Y_k X_j: propagated error of the inputs plus the three
      * roundings; every term positive, so the computed sum times 1.001 is an
      * upper bound. */
-    double E[3], eE[3];
+    double eE[3];
     int sg[3];
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3, k = (i + 2) % 3;
-        double a = X[k] * Y[j], c = Y[k] * X[j];
-        E[i] = a - c;
         eE[i] = 1.001 * (fabs(X[k]) * eY[j] + fabs(Y[j]) * eX[k] + eX[k] * eY[j] + fabs(Y[k]) * eX[j] +
-                         fabs(X[j]) * eY[k] + eX[j] * eY[k] + 2.0001 * u * (fabs(a) + fabs(c)));
+                         fabs(X[j]) * eY[k] + eX[j] * eY[k] + 2.0001 * u * (fabs(a[i]) + fabs(c[i])));
         sg[i] = E[i] > eE[i] ? 1 : E[i] < -eE[i] ? -1 : 0; /* 0: sign unknown */
     }
     if ((sg[0] < 0 || sg[1] < 0 || sg[2] < 0) && (sg[0] > 0 || sg[1] > 0 || sg[2] > 0)) return 1;

@@ -180,6 +180,43 @@ static void float_box_cases(long *decided, long *total) {
     }
 }
 
+/* A ray exactly through the midpoint of edge v0 v1: v1 an even number of
+ * ulps from v0 in the same binade (so the midpoint is a binary32), the
+ * origin 0 or within a factor of two of the midpoint on every axis (so
+ * d = midpoint - o is exact).  The edge function of v0 v1 is exactly 0 and
+ * the exact path hits (on the edge); the filters may decide such a ray only
+ * as a hit.  (Their binary64 value of that edge function comes out exactly
+ * 0 here too: the construction keeps X and Y exact, so it does not probe the
+ * size of the error bounds; near-edge random rays above do.) */
+static long n_exact_edge, n_exact_edge_hit;
+static int exact_edge_ray(cbvh_ray *ray, cbvh_f32 v[3][3]) {
+    cbvh_f32 o[3], d[3], v1[3];
+    int at0 = rnd() & 1;
+    for (int a = 0; a < 3; a++) {
+        cbvh_f32 x = v[0][a] & ~CBVH_F32_SIGN;
+        if (x < 0x00800000u || x >= 0x7F000000u) return 0; /* normal, not the top binade */
+        uint32_t step = 2u * (1u + below(1u << 21)); /* up to half the binade: v0 - o inexact */
+        v1[a] = v[0][a] + ((rnd() & 1) && (v[0][a] & CBVH_F32_FRAC) >= step ? -step : step);
+        float p0, p1;
+        memcpy(&p0, &v[0][a], 4);
+        memcpy(&p1, &v1[a], 4);
+        double mid = 0.5 * ((double)p0 + (double)p1);
+        float fo = at0 ? 0.0f : (float)(mid * (0.55 + 0.9 * (double)below(1000) / 1000.0));
+        double dd = mid - (double)fo;
+        if ((double)(float)mid != mid || (double)(float)dd != dd || !((float)dd != 0.0f)) return 0;
+        float df = (float)dd;
+        memcpy(&o[a], &fo, 4);
+        memcpy(&d[a], &df, 4);
+    }
+    memcpy(v[1], v1, sizeof v1);
+    memcpy(ray->o, o, sizeof o);
+    memcpy(ray->d, d, sizeof d);
+    ray->tmin = 0;
+    ray->tmax = CBVH_F32_POS_INF;
+    n_exact_edge++;
+    return 1;
+}
+
 static long typ_tri_miss, typ_tri_decided, typ_tri_hit, typ_tri_hit_decided, tri_hit_decided;
 
 static void tri_cases(long *decided, long *total, long *exact_hits) {
@@ -191,7 +228,8 @@ static void tri_cases(long *decided, long *total, long *exact_hits) {
         cbvh_f32 v[3][3];
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++) v[k][a] = rf(emid, spread);
-        uint32_t hard = typical ? 7 : below(8);
+        uint32_t hard = typical ? 7 : below(10);
+        int edge = 0;
         if (hard == 0) { /* through a vertex: d = v0 - o when exact */
             float o[3], p[3];
             for (int a = 0; a < 3; a++) {
@@ -213,6 +251,8 @@ static void tri_cases(long *decided, long *total, long *exact_hits) {
             memcpy(ray.o, v[2], sizeof ray.o);
         } else if (hard == 3) { /* degenerate: two equal vertices */
             memcpy(v[1], v[0], sizeof v[0]);
+        } else if (hard >= 8) { /* exactly through an edge's midpoint (below) */
+            edge = exact_edge_ray(&ray, v);
         } else if (hard == 4) { /* axis-parallel ray toward the triangle's box */
             int a = (int)below(3);
             for (int b = 0; b < 3; b++) ray.d[b] = (rnd() & 1) ? CBVH_F32_SIGN : 0;
@@ -230,6 +270,7 @@ static void tri_cases(long *decided, long *total, long *exact_hits) {
         uint32_t su = cbvh_ray_triangle(&ray, v[0], v[1], v[2], &ru);
         (*total)++;
         *exact_hits += re.hit;
+        n_exact_edge_hit += edge && re.hit;
         if (se != su || memcmp(&re, &ru, sizeof re)) {
             if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: unit != exact\n", i);
         }
@@ -322,6 +363,8 @@ int main(void) {
     printf("ray_triangle aimed rays: %d rays, %ld exact hits (%ld with t truncated to a power of two), hit filter decided %ld "
            "(%.2f%%)\n",
            NTRI, hh, hg, hd, 100.0 * (double)hd / (double)(hh ? hh : 1));
+    printf("ray_triangle: %ld rays exactly through an edge's midpoint, %ld exact hits\n", n_exact_edge,
+           n_exact_edge_hit);
     printf("ray_box grid: %ld inputs, fast path decided %ld (%.2f%%)\n", bt, bd, 100.0 * (double)bd / (double)bt);
     printf("ray_box float: %ld inputs, fast path decided %ld (%.2f%%)\n", ft, fd, 100.0 * (double)fd / (double)ft);
     printf("ray_triangle: %ld inputs (%ld exact hits), filter proved %ld misses (%.2f%% of the %ld misses)\n", tt, th,
@@ -335,7 +378,7 @@ int main(void) {
     /* the fast paths must carry the bulk of the work, or the speed-up is fake */
     if (typ_decided < typ_total * 99 / 100 || typ_tri_decided < typ_tri_miss * 9 / 10 || bd == 0 || fd == 0 ||
         td == 0 || typ_tri_hit == 0 || typ_tri_hit_decided < typ_tri_hit * 9 / 10 ||
-        hh < NTRI / 2 || hd < hh / 2) {
+        hh < NTRI / 2 || hd < hh / 2 || n_exact_edge_hit < NTRI / 40) {
         fprintf(stderr, "FAIL: fast paths decide too few cases\n");
         failures++;
     }
