@@ -234,10 +234,10 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     if (pos & neg) return 1;
     /* Bounds eX, eY, eZ on the errors of X, Y, Z = P_z (see the top of the
      * section): |X^ - X| <= 3.0002u (|px^ dz| + |pz^ dx|) < 4u (...)^ */
-    double Z[3], eX[3], eY[3], eZ[3];
+    const double *Z = pz;
+    double eX[3], eY[3], eZ[3];
     for (int i = 0; i < 3; i++) {
         double apz = fabs(pz[i]);
-        Z[i] = pz[i];
         eX[i] = 4.0 * u * (fabs(px[i]) * adz + apz * adx);
         eY[i] = 4.0 * u * (fabs(py[i]) * adz + apz * ady);
         eZ[i] = 1.0001 * u * apz;

@@ -195,7 +195,7 @@ static int exact_edge_ray(cbvh_ray *ray, cbvh_f32 v[3][3]) {
     for (int a = 0; a < 3; a++) {
         cbvh_f32 x = v[0][a] & ~CBVH_F32_SIGN;
         if (x < 0x00800000u || x >= 0x7F000000u) return 0; /* normal, not the top binade */
-        uint32_t step = 2u * (1u + below(1u << 21)); /* up to half the binade: v0 - o inexact */
+        uint32_t step = 2u * (1u + below(1u << 21)); /* an even number of ulps, up to half the binade */
         v1[a] = v[0][a] + ((rnd() & 1) && (v[0][a] & CBVH_F32_FRAC) >= step ? -step : step);
         float p0, p1;
         memcpy(&p0, &v[0][a], 4);
@@ -203,7 +203,7 @@ static int exact_edge_ray(cbvh_ray *ray, cbvh_f32 v[3][3]) {
         double mid = 0.5 * ((double)p0 + (double)p1);
         float fo = at0 ? 0.0f : (float)(mid * (0.55 + 0.9 * (double)below(1000) / 1000.0));
         double dd = mid - (double)fo;
-        if ((double)(float)mid != mid || (double)(float)dd != dd || !((float)dd != 0.0f)) return 0;
+        if ((double)(float)mid != mid || (double)(float)dd != dd || (float)dd == 0.0f) return 0;
         float df = (float)dd;
         memcpy(&o[a], &fo, 4);
         memcpy(&d[a], &df, 4);
@@ -251,14 +251,14 @@ static void tri_cases(long *decided, long *total, long *exact_hits) {
             memcpy(ray.o, v[2], sizeof ray.o);
         } else if (hard == 3) { /* degenerate: two equal vertices */
             memcpy(v[1], v[0], sizeof v[0]);
-        } else if (hard >= 8) { /* exactly through an edge's midpoint (below) */
-            edge = exact_edge_ray(&ray, v);
         } else if (hard == 4) { /* axis-parallel ray toward the triangle's box */
             int a = (int)below(3);
             for (int b = 0; b < 3; b++) ray.d[b] = (rnd() & 1) ? CBVH_F32_SIGN : 0;
             ray.d[a] = (rnd() & 1) ? 0xBF800000u : 0x3F800000u;
             for (int b = 0; b < 3; b++)
                 if (b != a) ray.o[b] = v[below(3)][b];
+        } else if (hard >= 8) { /* exactly through an edge's midpoint (below) */
+            edge = exact_edge_ray(&ray, v);
         }
         int bad = 0;
         for (int a = 0; a < 3; a++)
