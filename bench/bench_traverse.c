@@ -10,6 +10,8 @@
  *   - the float BVH collapsed 4-wide (cbvh_qbvh_from_bvh) with the same plain
  *     floating-point box test in four lanes (cbvh_trace_qbvh_float), whose
  *     hit count must equal the plain traversal's (else exit 1),
+ *   - the float BVH collapsed 8-wide (cbvh_f8bvh_build) with the same box
+ *     test in eight lanes (cbvh_trace_f8bvh_float), likewise checked,
  * closest hit and any hit, one core, as ratios to Embree.
  *
  * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]
@@ -35,6 +37,7 @@
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
+#include "cbvh/f8bvh.h"
 #include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 #define BENCH_NAME "bench_traverse"
@@ -54,8 +57,10 @@ typedef struct {
 } result;
 
 /* tracer: 0 float BVH through the units, 1 CBVH, 2 float BVH plain float,
- * 3 CBVH decoded once, 4 float BVH collapsed 4-wide, plain float */
-static result run_ours(int cbvh, const cbvh_bvh *b, const cbvh_fbvh *fb, const cbvh_fqbvh *fq, const cbvh_tree *t,
+ * 3 CBVH decoded once, 4 float BVH collapsed 4-wide, plain float, 5 the same
+ * 8-wide */
+static result run_ours(int cbvh, const cbvh_bvh *b, const cbvh_fbvh *fb, const cbvh_fqbvh *fq,
+                       const cbvh_f8bvh *f8, const cbvh_tree *t,
                        const cbvh_cbvh_decoded *dec, const cbvh_tri *tris, const cbvh_ray *rays, int n,
                        cbvh_trav_mode mode, int reps, cbvh_trav_stats *st) {
     result res = {0, 0};
@@ -70,6 +75,7 @@ static result run_ours(int cbvh, const cbvh_bvh *b, const cbvh_fbvh *fb, const c
                      : cbvh == 3 ? cbvh_trace_cbvh_decoded(dec, tris, &rays[i], 24, mode, &h, &s)
                      : cbvh == 2 ? cbvh_trace_bvh_float(fb, tris, &rays[i], mode, &h, &s)
                      : cbvh == 4 ? cbvh_trace_qbvh_float(fq, tris, &rays[i], mode, &h, &s)
+                     : cbvh == 5 ? cbvh_trace_f8bvh_float(f8, tris, &rays[i], mode, &h, &s)
                                  : cbvh_trace_bvh(b, tris, &rays[i], 24, mode, &h, &s);
             if (rc) die("trace", "ray rejected");
             hits += h.hit;
@@ -109,10 +115,11 @@ int main(int argc, char **argv) {
 #endif
     char err[512];
     printf("%-24s %7s %-12s %11s %11s %11s %11s %11s %11s %8s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s "
-           "%7s %7s %7s\n",
+           "%7s %7s %7s %11s %8s %7s %7s\n",
            "scene", "tris", "kind", "embree_r/s", "float_r/s", "bvh_r/s", "cbvh_r/s", "cbvhd_r/s", "flt4_r/s",
            "float/e", "bvh/emb", "cbvh/emb", "cbvhd/e", "float4/e", "hits_e", "hits_f", "hits_b", "hits_c", "flt_box",
-           "flt_tri", "bvh_box", "bvh_tri", "cbv_box", "cbv_tri", "fl4_box", "fl4_tri");
+           "flt_tri", "bvh_box", "bvh_tri", "cbv_box", "cbv_tri", "fl4_box", "fl4_tri", "flt8_r/s", "float8/e",
+           "fl8_box", "fl8_tri");
     cbvh_ray *rays = malloc((size_t)nrays * sizeof *rays);
     if (!rays) die("rays", "out of memory");
     for (int si = 0; si < ns; si++) {
@@ -128,6 +135,8 @@ int main(int argc, char **argv) {
         cbvh_fqbvh fq;
         if (cbvh_qbvh_from_bvh(&b, &qb, err, sizeof err) || cbvh_fqbvh_build(&qb, s.tris, s.ntris, &fq, err, sizeof err))
             die("4-wide layout", err);
+        cbvh_f8bvh f8;
+        if (cbvh_f8bvh_build(&b, s.tris, s.ntris, &f8, err, sizeof err)) die("8-wide layout", err);
         cbvh_cbvh_decoded dt;
         double d0 = now();
         if (cbvh_cbvh_decode(&t, &dt, err, sizeof err) || cbvh_cbvh_decode_leaves(&dt, s.tris, s.ntris, err, sizeof err))
@@ -153,20 +162,22 @@ int main(int argc, char **argv) {
             for (int mode = 0; mode < 2; mode++) {
                 /* repetitions interleave the tracers so that load changes on the
                  * shared machine hit all of them alike; best time of each */
-                cbvh_trav_stats sb = {0}, sc_ = {0}, sf = {0}, sd = {0}, sq = {0};
-                result rb = {0, 0}, rc = {0, 0}, re = {0, 0}, rf = {0, 0}, rd = {0, 0}, rq = {0, 0};
+                cbvh_trav_stats sb = {0}, sc_ = {0}, sf = {0}, sd = {0}, sq = {0}, s8 = {0};
+                result rb = {0, 0}, rc = {0, 0}, re = {0, 0}, rf = {0, 0}, rd = {0, 0}, rq = {0, 0}, r8 = {0, 0};
                 cbvh_trav_mode md = (cbvh_trav_mode)mode;
                 for (int k = 0; k < reps; k++) {
-                    result y = run_ours(2, &b, &fb, &fq, &t, &dt, s.tris, rr, n, md, 1, &sf);
+                    result y = run_ours(2, &b, &fb, &fq, &f8, &t, &dt, s.tris, rr, n, md, 1, &sf);
                     if (y.rays_per_s > rf.rays_per_s) rf = y;
-                    result x = run_ours(0, &b, &fb, &fq, &t, &dt, s.tris, rr, n, md, 1, &sb);
+                    result x = run_ours(0, &b, &fb, &fq, &f8, &t, &dt, s.tris, rr, n, md, 1, &sb);
                     if (x.rays_per_s > rb.rays_per_s) rb = x;
-                    x = run_ours(1, &b, &fb, &fq, &t, &dt, s.tris, rr, n, md, 1, &sc_);
+                    x = run_ours(1, &b, &fb, &fq, &f8, &t, &dt, s.tris, rr, n, md, 1, &sc_);
                     if (x.rays_per_s > rc.rays_per_s) rc = x;
-                    x = run_ours(3, &b, &fb, &fq, &t, &dt, s.tris, rr, n, md, 1, &sd);
+                    x = run_ours(3, &b, &fb, &fq, &f8, &t, &dt, s.tris, rr, n, md, 1, &sd);
                     if (x.rays_per_s > rd.rays_per_s) rd = x;
-                    x = run_ours(4, &b, &fb, &fq, &t, &dt, s.tris, rr, n, md, 1, &sq);
+                    x = run_ours(4, &b, &fb, &fq, &f8, &t, &dt, s.tris, rr, n, md, 1, &sq);
                     if (x.rays_per_s > rq.rays_per_s) rq = x;
+                    x = run_ours(5, &b, &fb, &fq, &f8, &t, &dt, s.tris, rr, n, md, 1, &s8);
+                    if (x.rays_per_s > r8.rays_per_s) r8 = x;
 #ifdef CBVH_HAVE_EMBREE
                     x = run_embree(sc, rr, n, mode, 1);
                     if (x.rays_per_s > re.rays_per_s) re = x;
@@ -175,18 +186,21 @@ int main(int argc, char **argv) {
                 if (rd.hits != rc.hits || memcmp(&sd, &sc_, sizeof sd))
                     die("decoded CBVH", "hits or counters differ from the CBVH traversal's");
                 if (rq.hits != rf.hits) die("4-wide float", "hits differ from the plain float traversal's");
+                if (r8.hits != rf.hits) die("8-wide float", "hits differ from the plain float traversal's");
                 char kind[16];
                 snprintf(kind, sizeof kind, "%s-%s", half ? "rand" : "cam", mode ? "any" : "closest");
                 /* work per ray behind the throughput: box and triangle tests */
                 double e = re.rays_per_s > 0 ? re.rays_per_s : 0;
                 printf("%-24s %7u %-12s %11.0f %11.0f %11.0f %11.0f %11.0f %11.0f %8.4f %8.4f %8.4f %8.4f %8.4f "
-                       "%8ld %8ld %8ld %8ld %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f\n",
+                       "%8ld %8ld %8ld %8ld %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %11.0f %8.4f %7.2f %7.2f\n",
                        base, s.ntris, kind, re.rays_per_s, rf.rays_per_s, rb.rays_per_s, rc.rays_per_s,
                        rd.rays_per_s, rq.rays_per_s, e > 0 ? rf.rays_per_s / e : 0, e > 0 ? rb.rays_per_s / e : 0,
                        e > 0 ? rc.rays_per_s / e : 0, e > 0 ? rd.rays_per_s / e : 0, e > 0 ? rq.rays_per_s / e : 0,
                        re.hits, rf.hits, rb.hits, rc.hits, (double)sf.box_tests / n, (double)sf.tri_tests / n,
                        (double)sb.box_tests / n, (double)sb.tri_tests / n, (double)sc_.box_tests / n,
-                       (double)sc_.tri_tests / n, (double)sq.box_tests / n, (double)sq.tri_tests / n);
+                       (double)sc_.tri_tests / n, (double)sq.box_tests / n, (double)sq.tri_tests / n,
+                       r8.rays_per_s, e > 0 ? r8.rays_per_s / e : 0, (double)s8.box_tests / n,
+                       (double)s8.tri_tests / n);
                 fflush(stdout);
             }
         }
@@ -195,6 +209,7 @@ int main(int argc, char **argv) {
 #endif
         cbvh_cbvh_decoded_free(&dt);
         cbvh_fqbvh_free(&fq);
+        cbvh_f8bvh_free(&f8);
         cbvh_qbvh_free(&qb);
         cbvh_tree_free(&t);
         cbvh_fbvh_free(&fb);

@@ -12,14 +12,15 @@
  *     value, hit and counters;
  *   - on an uncorrupted tree both succeed and hit exactly what brute force
  *     over the ray-triangle unit hits (closest: the same triangle and t);
- *   - so do the plain float traversals of the float BVH (binary, and 4-wide
- *     over its QBVH collapse, with the leaf copy when bit 64 is set), and
- *     they reject (-1) the rays the units reject. */
+ *   - so do the plain float traversals of the float BVH (binary, 4-wide
+ *     over its QBVH collapse and 8-wide, with the leaf copies when bit 64 is
+ *     set), and they reject (-1) the rays the units reject. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cbvh/cbvh_tree.h"
+#include "cbvh/f8bvh.h"
 #include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 
@@ -107,10 +108,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cbvh_fbvh fb;
     cbvh_qbvh qb;
     cbvh_fqbvh fq;
+    cbvh_f8bvh f8;
     if (cbvh_fbvh_build(&b, &fb, err, sizeof err) || cbvh_qbvh_from_bvh(&b, &qb, err, sizeof err) ||
-        cbvh_fqbvh_build(&qb, (mode & 64) ? tris : NULL, s.ntris, &fq, err, sizeof err))
+        cbvh_fqbvh_build(&qb, (mode & 64) ? tris : NULL, s.ntris, &fq, err, sizeof err) ||
+        cbvh_f8bvh_build(&b, (mode & 64) ? tris : NULL, s.ntris, &f8, err, sizeof err))
         abort(); /* a BVH the builders emit is one the layouts take */
-    if ((mode & 64) && !fq.leaf_tris) abort();
+    if ((mode & 64) && (!fq.leaf_tris || !f8.leaf_tris)) abort();
     int corrupt = get8(&rd) % 4;
     for (int k = 0; k < corrupt && t.npairs; k++) t.pairs[get32(&rd) % (t.npairs * t.pair_bytes)] ^= get8(&rd);
     if (mode & 8) {
@@ -137,16 +140,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             int r1 = cbvh_trace_cbvh(&t, tris, &ray, M, (cbvh_trav_mode)m, &h1, &s1);
             int r2 = cbvh_trace_cbvh_decoded(&d, tris, &ray, M, (cbvh_trav_mode)m, &h2, &s2);
             if (r1 != r2 || memcmp(&h1, &h2, sizeof h1) || memcmp(&s1, &s2, sizeof s1)) abort();
-            cbvh_trav_hit hf, hq;
+            cbvh_trav_hit hf, hq, h8;
             int rf = cbvh_trace_bvh_float(&fb, tris, &ray, (cbvh_trav_mode)m, &hf, &s2);
             int rq = cbvh_trace_qbvh_float(&fq, tris, &ray, (cbvh_trav_mode)m, &hq, &s2);
+            int r8 = cbvh_trace_f8bvh_float(&f8, tris, &ray, (cbvh_trav_mode)m, &h8, &s2);
             int rejected = brute(tris, s.ntris, &ray, &want);
             if (rejected) { /* a ray the units reject */
-                if (rf != -1 || rq != -1 || hf.hit || hq.hit) abort();
+                if (rf != -1 || rq != -1 || r8 != -1 || hf.hit || hq.hit || h8.hit) abort();
                 continue;
             }
-            if (rf || hf.hit != want.hit || rq || hq.hit != want.hit) abort();
-            if (m == 0 && want.hit && (hf.prim != want.prim || hf.t != want.t || hq.prim != want.prim || hq.t != want.t))
+            if (rf || hf.hit != want.hit || rq || hq.hit != want.hit || r8 || h8.hit != want.hit) abort();
+            if (m == 0 && want.hit && (hf.prim != want.prim || hf.t != want.t || hq.prim != want.prim || hq.t != want.t ||
+                                       h8.prim != want.prim || h8.t != want.t))
                 abort();
             if (corrupt) continue; /* -1 or any result above */
             if (r1 || h1.hit != want.hit) abort();
@@ -156,6 +161,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cbvh_cbvh_decoded_free(&d);
     cbvh_tree_free(&t);
     cbvh_fqbvh_free(&fq);
+    cbvh_f8bvh_free(&f8);
     cbvh_qbvh_free(&qb);
     cbvh_fbvh_free(&fb);
     cbvh_bvh_free(&b);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cbvh/qbvh.h"
+#include "collapse.h"
 
 void cbvh_qbvh_free(cbvh_qbvh *q) {
     free(q->bmin);
@@ -22,14 +23,14 @@ static double half_area(const cbvh_bvh_node *n) {
     return dx * dy + dy * dz + dz * dx;
 }
 
-/* Up to 4 binary nodes under inner node `src`: open the inner child of largest
- * area (the leftmost of equal ones: strict >) until there are 4, keeping
- * left-to-right order. */
-static int gather(const cbvh_bvh *b, uint32_t src, uint32_t out[4]) {
-    int n = 2;
-    out[0] = b->nodes[src].child[0];
-    out[1] = b->nodes[src].child[1];
-    while (n < 4) {
+int cbvh_collapse_gather(const cbvh_bvh *b, uint32_t src, int w, uint32_t *out, uint8_t *seen) {
+    int n = 0;
+    for (int c = 0; c < 2; c++) {
+        uint32_t k = b->nodes[src].child[c];
+        if (k >= b->nnodes || (seen && seen[k]++)) return -1;
+        out[n++] = k;
+    }
+    while (n < w) {
         int best = -1;
         double ba = -1;
         for (int i = 0; i < n; i++) {
@@ -42,10 +43,11 @@ static int gather(const cbvh_bvh *b, uint32_t src, uint32_t out[4]) {
             }
         }
         if (best < 0) break;
-        uint32_t open = out[best];
+        uint32_t open = out[best], k0 = b->nodes[open].child[0], k1 = b->nodes[open].child[1];
+        if (k0 >= b->nnodes || k1 >= b->nnodes || (seen && (seen[k0]++ || seen[k1]++))) return -1;
         memmove(&out[best + 2], &out[best + 1], (size_t)(n - best - 1) * sizeof out[0]);
-        out[best] = b->nodes[open].child[0];
-        out[best + 1] = b->nodes[open].child[1];
+        out[best] = k0;
+        out[best + 1] = k1;
         n++;
     }
     return n;
@@ -102,9 +104,9 @@ int cbvh_qbvh_from_bvh(const cbvh_bvh *b, cbvh_qbvh *out, char *err, size_t errl
             continue;
         }
         uint32_t ch[4];
-        int k = gather(b, src[i], ch);
-        if (q.nnodes > cap - (uint32_t)k) {
-            snprintf(err, errlen, "qbvh: binary BVH is not a tree (more nodes reached than it has)");
+        int k = cbvh_collapse_gather(b, src[i], 4, ch, NULL);
+        if (k < 0 || q.nnodes > cap - (uint32_t)k) {
+            snprintf(err, errlen, "qbvh: binary BVH is not a tree (a child outside it, or more nodes reached than it has)");
             goto fail;
         }
         q.first[i] = q.nnodes;

@@ -115,7 +115,7 @@ static inline void cbvh_ref_box2(const cbvh_ref_ray *r, const float box[12], dou
 /* Any valid ray (zero direction components, tmin < 0): an axis with d_a = 0
  * constrains nothing where o_a lies in the closed slab, else the box is
  * missed; the slack is the sign-free N <= F + (|N| + |F|) * 2^-50.  w boxes
- * (2 or 4), plane of axis a of box c at ((plane * 3) + a) * w + c. */
+ * (2, 4 or 8), plane of axis a of box c at ((plane * 3) + a) * w + c. */
 static inline void cbvh_ref_boxw_any(const cbvh_ref_ray *r, const float *box, int w, double cull, int *hit,
                                      double *t_lo) {
     for (int c = 0; c < w; c++) {
@@ -143,6 +143,25 @@ static inline void cbvh_ref_box2_any(const cbvh_ref_ray *r, const float box[12],
     cbvh_ref_boxw_any(r, box, 2, cull, hit, t_lo);
 }
 
+/* cbvh_ref_box2_c on w boxes (4 or 8; plane of axis a of box c at
+ * ((plane * 3) + a) * w + c): the plain C of cbvh_ref_box4 / box8.  Returns
+ * the hit mask (bit c for box c). */
+static inline int cbvh_ref_boxw_c(const cbvh_ref_ray *r, const float *box, int w, double cull, double *t_lo) {
+    int m = 0;
+    for (int c = 0; c < w; c++) {
+        double n = r->tmin, f = cull;
+        for (int a = 0; a < 3; a++) {
+            double tn = ((double)box[r->pn4[a] / 4 * w + c] - r->o[a]) * r->inv[a];
+            double tf = ((double)box[r->pf4[a] / 4 * w + c] - r->o[a]) * r->inv[a];
+            n = tn > n ? tn : n;
+            f = tf < f ? tf : f;
+        }
+        t_lo[c] = n * (1 - CBVH_REF_EPS);
+        m |= (n <= f * (1 + CBVH_REF_EPS)) << c;
+    }
+    return m;
+}
+
 /* cbvh_ref_box2 on four boxes (a 4-wide node, planes at CBVH_REF4_AT):
  * lane by lane the same operations, so the same results as cbvh_ref_box2_c
  * on any two of them.  Returns the hit mask (bit c for box c). */
@@ -167,19 +186,40 @@ static inline int cbvh_ref_box4(const cbvh_ref_ray *r, const float box[24], doub
     return _mm_movemask_pd(_mm_cmple_pd(n01, _mm_mul_pd(f01, hi))) |
            _mm_movemask_pd(_mm_cmple_pd(n23, _mm_mul_pd(f23, hi))) << 2;
 #else
-    int m = 0;
-    for (int c = 0; c < 4; c++) {
-        double n = r->tmin, f = cull;
-        for (int a = 0; a < 3; a++) {
-            double tn = ((double)box[r->pn4[a] + c] - r->o[a]) * r->inv[a];
-            double tf = ((double)box[r->pf4[a] + c] - r->o[a]) * r->inv[a];
-            n = tn > n ? tn : n;
-            f = tf < f ? tf : f;
+    return cbvh_ref_boxw_c(r, box, 4, cull, t_lo);
+#endif
+}
+
+/* cbvh_ref_box4 on eight boxes (an 8-wide node, plane of axis a of box c at
+ * ((plane * 3) + a) * 8 + c: twice the 4-wide offsets): lanes 2k, 2k + 1 in
+ * register pair k, the same operations per box as cbvh_ref_box2_c.  Returns
+ * the hit mask (bit c for box c). */
+static inline int cbvh_ref_box8(const cbvh_ref_ray *r, const float box[48], double cull, double t_lo[8]) {
+#if CBVH_REF_SSE2
+    __m128d n[4], f[4];
+    for (int k = 0; k < 4; k++) {
+        n[k] = _mm_set1_pd(r->tmin);
+        f[k] = _mm_set1_pd(cull);
+    }
+    for (int a = 0; a < 3; a++) {
+        const float *pn = box + 2 * r->pn4[a], *pf = box + 2 * r->pf4[a];
+        __m128d o = _mm_load_pd(r->o2[a]), inv = _mm_load_pd(r->inv2[a]);
+        for (int k = 0; k < 4; k++) {
+            __m128d tn = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(pn + 2 * k))));
+            __m128d tf = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(pf + 2 * k))));
+            n[k] = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(tn, o), inv), n[k]);
+            f[k] = _mm_min_pd(_mm_mul_pd(_mm_sub_pd(tf, o), inv), f[k]);
         }
-        t_lo[c] = n * (1 - CBVH_REF_EPS);
-        m |= (n <= f * (1 + CBVH_REF_EPS)) << c;
+    }
+    __m128d lo = _mm_set1_pd(1 - CBVH_REF_EPS), hi = _mm_set1_pd(1 + CBVH_REF_EPS);
+    int m = 0;
+    for (int k = 0; k < 4; k++) {
+        _mm_storeu_pd(t_lo + 2 * k, _mm_mul_pd(n[k], lo));
+        m |= _mm_movemask_pd(_mm_cmple_pd(n[k], _mm_mul_pd(f[k], hi))) << 2 * k;
     }
     return m;
+#else
+    return cbvh_ref_boxw_c(r, box, 8, cull, t_lo);
 #endif
 }
 

@@ -124,11 +124,7 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
     if (have) max_stack = 1;
     while (have) {
         if (e & CBVH_FBVH_LEAF) {
-            uint32_t first = e & ~CBVH_FBVH_LEAF;
-            trav_fetch(&ts, ts.ids_base + (uint64_t)first * 4u, (uint64_t)cnt * 4u);
-            for (uint32_t i = 0; i < cnt && !ts.done; i++) trav_triangle(&ts, b->prims[first + i]);
-            if (ts.done) break;
-            cull = cbvh_float_of(trav_box_tmax(&ts));
+            if (plain_leaf(&ts, e & ~CBVH_FBVH_LEAF, cnt, NULL, b->prims, &cull)) break;
         } else {
             const cbvh_fbvh_node *n = &f->nodes[e];
             nodes++; /* in the float BVH's image one 64-byte line, and two box tests */
@@ -154,10 +150,6 @@ int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ra
         }
         have = plain_pop(stack, &sp, cull, &e, &cnt);
     }
-    ts.s.nodes += nodes;
-    ts.s.box_tests += 2 * nodes;
-    ts.s.lines += nodes;
-    ts.s.max_stack = max_stack;
-    trav_finish(&ts, hit, st);
+    plain_finish(&ts, nodes, 2 * nodes, nodes, max_stack, hit, st);
     return 0;
 }

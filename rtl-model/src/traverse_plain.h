@@ -47,4 +47,33 @@ static inline int plain_root(trav_state *ts, const cbvh_ref_ray *r, const float 
     return h[0];
 }
 
+/* A leaf's cnt triangles from prims[first]: read from the leaf copy lt when
+ * given (the same triangles side by side), else through the ID array.
+ * Returns 1 when an any-hit traversal is done, else 0 with *cull the
+ * culling bound after them. */
+static inline int plain_leaf(trav_state *ts, uint32_t first, uint32_t cnt, const cbvh_cbvh_dtri *lt,
+                             const uint32_t *prims, double *cull) {
+    trav_fetch(ts, ts->ids_base + (uint64_t)first * 4u, (uint64_t)cnt * 4u);
+    if (lt) {
+        for (uint32_t i = 0; i < cnt && !ts->done; i++)
+            trav_triangle_v(ts, lt[first + i].id, (const cbvh_f32(*)[3])lt[first + i].v);
+    } else {
+        for (uint32_t i = 0; i < cnt && !ts->done; i++) trav_triangle(ts, prims[first + i]);
+    }
+    if (ts->done) return 1;
+    *cull = cbvh_float_of(trav_box_tmax(ts));
+    return 0;
+}
+
+/* The end of a plain traversal: its loop's counters into the state, then
+ * trav_finish. */
+static inline void plain_finish(trav_state *ts, uint64_t nodes, uint64_t boxes, uint64_t lines, uint32_t max_stack,
+                                cbvh_trav_hit *hit, cbvh_trav_stats *st) {
+    ts->s.nodes += nodes;
+    ts->s.box_tests += boxes;
+    ts->s.lines += lines;
+    ts->s.max_stack = max_stack;
+    trav_finish(ts, hit, st);
+}
+
 #endif

@@ -9,17 +9,9 @@
 #include <stdlib.h>
 
 #include "cbvh/qbvh.h"
-#include "ray_box_ref.h"
-#include "traverse_common.h"
-#include "traverse_plain.h"
+#include "traverse_wide_float.h"
 
 _Static_assert(sizeof(cbvh_fqbvh_node) == 128, "one record per two 64-byte lines");
-
-/* bits set in a 4-bit mask (the x86-64 baseline has no popcount
- * instruction), its lowest and highest set bit */
-static const uint8_t ones4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
-static const uint8_t low4[16] = {0, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0};
-static const uint8_t high4[16] = {0, 0, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 3, 3, 3, 3};
 
 void cbvh_fqbvh_free(cbvh_fqbvh *f) {
     free(f->nodes);
@@ -112,101 +104,14 @@ int cbvh_fqbvh_build(const cbvh_qbvh *q, const cbvh_tri *tris, uint32_t ntris, c
     return 0;
 }
 
+_Static_assert(sizeof(cbvh_fqbvh_node) == WIDE_REC_BYTES(4) && offsetof(cbvh_fqbvh_node, child) == WIDE_CHILD_AT(4) &&
+                   offsetof(cbvh_fqbvh_node, count) == WIDE_COUNT_AT(4) &&
+                   offsetof(cbvh_fqbvh_node, valid) == WIDE_VALID_AT(4) && CBVH_FQBVH_LEAF == WIDE_LEAF,
+               "the 4-wide record is traverse_wide_float.h's of width 4");
+
 int cbvh_trace_qbvh_float(const cbvh_fqbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
                           cbvh_trav_hit *hit, cbvh_trav_stats *st) {
-    const cbvh_qbvh *q = f->q;
-    trav_state ts;
-    if (trav_begin(&ts, hit, ray, CBVH_MANT_MAX, tris, mode, (uint64_t)f->nnodes * sizeof(cbvh_fqbvh_node),
-                   q->nprims))
-        return -1;
-    cbvh_ref_ray r;
-    cbvh_ref_prepare(ray, &r);
-    const cbvh_cbvh_dtri *lt = f->leaf_tris && f->leaf_src == tris ? f->leaf_tris : NULL;
-    plain_entry stack[CBVH_TRAV_STACK];
-    int sp = 0;
-    uint32_t max_stack = 0;
-    uint64_t nodes = 0, boxes = 0;
-    double cull;
-    int have = plain_root(&ts, &r, f->root_box, &cull);
-    double tl[4];
-    /* As in cbvh_trace_bvh_float: the nearest hit child is visited next
-     * without a push, the others pushed farthest first; max_stack counts
-     * the visited entry. */
-    uint32_t e = f->root, cnt = f->root_count;
-    if (have) max_stack = 1;
-    while (have) {
-        if (e & CBVH_FQBVH_LEAF) {
-            uint32_t first = e & ~CBVH_FQBVH_LEAF;
-            trav_fetch(&ts, ts.ids_base + (uint64_t)first * 4u, (uint64_t)cnt * 4u);
-            if (lt) {
-                for (uint32_t i = 0; i < cnt && !ts.done; i++)
-                    trav_triangle_v(&ts, lt[first + i].id, (const cbvh_f32(*)[3])lt[first + i].v);
-            } else {
-                for (uint32_t i = 0; i < cnt && !ts.done; i++) trav_triangle(&ts, q->prims[first + i]);
-            }
-            if (ts.done) break;
-            cull = cbvh_float_of(trav_box_tmax(&ts));
-        } else {
-            const cbvh_fqbvh_node *n = &f->nodes[e];
-            nodes++;
-            boxes += ones4[n->valid & 15u];
-            int m;
-            if (r.general) {
-                int hh[4];
-                cbvh_ref_boxw_any(&r, n->pl, 4, cull, hh, tl);
-                m = hh[0] | hh[1] << 1 | hh[2] << 2 | hh[3] << 3;
-            } else {
-                m = cbvh_ref_box4(&r, n->pl, cull, tl);
-            }
-            m &= (int)n->valid;
-            if (m) {
-                int nh = ones4[m], next;
-                if (sp + nh > CBVH_TRAV_STACK) return -1;
-                if (nh == 1) {
-                    next = low4[m];
-                } else if (nh == 2) { /* the common case: one comparison (ties: the lower slot first) */
-                    int a = low4[m], b = high4[m];
-                    if (tl[b] < tl[a]) {
-                        next = b;
-                        b = a;
-                    } else {
-                        next = a;
-                    }
-                    plain_push(stack, &sp, n->child[b], n->count[b], tl[b]);
-                    if (!(n->child[b] & CBVH_FQBVH_LEAF)) __builtin_prefetch(&f->nodes[n->child[b]]);
-                } else { /* hit children by t_lo, ties by slot: push all but the nearest, farthest first */
-                    int ord[4] = {0, 0, 0, 0}, k = 0;
-                    for (int c = 0; c < 4; c++) {
-                        if (!(m >> c & 1)) continue;
-                        int j = k++;
-                        while (j > 0 && tl[ord[j - 1]] > tl[c]) {
-                            ord[j] = ord[j - 1];
-                            j--;
-                        }
-                        ord[j] = c;
-                    }
-                    for (int j = k - 1; j > 0; j--) {
-                        int c = ord[j];
-                        plain_push(stack, &sp, n->child[c], n->count[c], tl[c]);
-                        if (!(n->child[c] & CBVH_FQBVH_LEAF)) __builtin_prefetch(&f->nodes[n->child[c]]);
-                    }
-                    next = ord[0];
-                }
-                if ((uint32_t)sp + 1u > max_stack) max_stack = (uint32_t)sp + 1u;
-                /* the pop's cull check (rounding can leave t_lo just above cull) */
-                if (!(tl[next] > cull)) {
-                    e = n->child[next];
-                    cnt = n->count[next];
-                    continue;
-                }
-            }
-        }
-        have = plain_pop(stack, &sp, cull, &e, &cnt);
-    }
-    ts.s.nodes += nodes;
-    ts.s.box_tests += boxes;
-    ts.s.lines += 2 * nodes;
-    ts.s.max_stack = max_stack;
-    trav_finish(&ts, hit, st);
-    return 0;
+    const wide_tree w = {(const unsigned char *)f->nodes, f->nnodes, f->root, f->root_count,
+                         f->root_box, f->leaf_tris, f->leaf_src, f->q->prims, f->q->nprims};
+    return wide_trace(4, &w, tris, ray, mode, hit, st);
 }

@@ -369,6 +369,11 @@ static void collapse_ties(void) {
         CHECK(got == want_b[c], "B child %d: primitive %d, want %d", c, got, want_b[c]);
     }
     cbvh_qbvh_free(&q);
+    /* a child index outside the binary BVH, met when node 5 is opened: refused, not read */
+    n[5].child[1] = 11;
+    err[0] = 0;
+    CHECK(cbvh_qbvh_from_bvh(&b, &q, err, sizeof err) == -1 && strstr(err, "not a tree") && !q.nnodes,
+          "collapse of a BVH with a child outside it: %s", err);
 }
 
 int main(void) {

@@ -12,10 +12,11 @@
  *     then gives the same leaf/empty/pointer, relative coordinates and child
  *     contexts as cbvh_nodepair_decode + cbvh_axis_child_ctx;
  *   - the plain float traversals' slab test (rtl-model/src/ray_box_ref.h):
- *     cbvh_ref_box2 (SSE2 lanes on x86-64) and the four-box cbvh_ref_box4
- *     equal the plain C cbvh_ref_box2_c bit for bit on every box (whose
- *     conservativeness tests/traversal/test_ray_box.c checks against exact
- *     rationals), and the general variant on four boxes equals it on two;
+ *     cbvh_ref_box2 (SSE2 lanes on x86-64), the four-box cbvh_ref_box4 and
+ *     the eight-box cbvh_ref_box8 equal the plain C cbvh_ref_box2_c bit for
+ *     bit on every box (whose conservativeness tests/traversal/test_ray_box.c
+ *     checks against exact rationals), and the general variant on four and
+ *     eight boxes equals it on two;
  *   - and the filter decides nearly all scene-like inputs (so the comparison
  *     is not vacuous and the speed-up is real).
  * Inputs: random values over wide exponent ranges plus hard cases - plane
@@ -520,7 +521,7 @@ static void test_ref_lanes(void) {
             continue;
         cbvh_ref_ray r;
         cbvh_ref_prepare(&ray, &r);
-        float b4[24], b2[2][12];
+        float b4[24], b2[2][12], b8[48];
         for (int c = 0; c < 4; c++)
             for (int a = 0; a < 3; a++) {
                 float x = ref_coord(wide), y = (rnd() & 3) ? ref_coord(wide) : x;
@@ -533,8 +534,12 @@ static void test_ref_lanes(void) {
                 b4[CBVH_REF4_AT(1, a, c)] = b2[c / 2][CBVH_REF_AT(1, a, c % 2)] = hi;
             }
         double cull = (rnd() & 3) ? cbvh_float_of(ray.tmax) : fabs((double)ref_coord(0));
-        int h[4], g[4];
-        double t[4], u[4];
+        /* eight boxes: slot c holds box c, slot c + 4 box 3 - c */
+        for (int c = 0; c < 8; c++)
+            for (int p = 0; p < 2; p++)
+                for (int a = 0; a < 3; a++) b8[(p * 3 + a) * 8 + c] = b4[CBVH_REF4_AT(p, a, c < 4 ? c : 7 - c)];
+        int h[4], g[4], g8[8];
+        double t[4], u[4], u8[8];
         if (!r.general && (i & 3) == 2) { /* cull just below a box's entry: a hit only through the far margin */
             for (int k = 0; k < 2; k++) cbvh_ref_box2_c(&r, b2[k], HUGE_VAL, h + 2 * k, t + 2 * k);
             for (int j = 0, c0 = (int)below(4); j < 4; j++) {
@@ -549,11 +554,14 @@ static void test_ref_lanes(void) {
         if (r.general) {
             ngeneral++;
             cbvh_ref_boxw_any(&r, b4, 4, cull, g, u);
+            cbvh_ref_boxw_any(&r, b8, 8, cull, g8, u8);
             for (int k = 0; k < 2; k++) cbvh_ref_box2_any(&r, b2[k], cull, h + 2 * k, t + 2 * k);
         } else {
             for (int k = 0; k < 2; k++) cbvh_ref_box2_c(&r, b2[k], cull, h + 2 * k, t + 2 * k);
             int m = cbvh_ref_box4(&r, b4, cull, u);
             for (int c = 0; c < 4; c++) g[c] = m >> c & 1;
+            int m8 = cbvh_ref_box8(&r, b8, cull, u8);
+            for (int c = 0; c < 8; c++) g8[c] = m8 >> c & 1;
             int h2[2];
             double t2[2];
             for (int k = 0; k < 2; k++) { /* the two-box lanes too */
@@ -570,9 +578,15 @@ static void test_ref_lanes(void) {
                 printf("FAIL ref lanes %ld box %d (%s): four-box hit %d t_lo %a, two-box hit %d t_lo %a\n", i, c,
                        r.general ? "general" : "fast", g[c], u[c], h[c], t[c]);
         }
+        for (int c = 0; c < 8; c++) {
+            int k = c < 4 ? c : 7 - c;
+            if ((g8[c] != h[k] || memcmp(&u8[c], &t[k], sizeof u8[c])) && failures++ < 10)
+                printf("FAIL ref lanes %ld slot %d (%s): eight-box hit %d t_lo %a, two-box hit %d t_lo %a\n", i, c,
+                       r.general ? "general" : "fast", g8[c], u8[c], h[k], t[k]);
+        }
     }
     printf("plain float slab test: %ld rays x 4 boxes (%ld general, %ld culled just below an entry), %ld box hits; "
-           "four-box and two-box lanes (%s) equal the plain C\n",
+           "eight-, four- and two-box lanes (%s) equal the plain C\n",
            n, ngeneral, n_margin, nhit, CBVH_REF_SSE2 ? "SSE2" : "plain C");
     if (n < NBOX / 2 || ngeneral < n / 20 || n_margin < n / 200 || nhit < n / 4 || nhit > 3 * n) {
         printf("FAIL: plain float lane test inputs not varied enough\n");

@@ -20,6 +20,7 @@
 #include "cbvh/traverse.h"
 #include "cbvh/unit_table.h"
 #include "test_trav_util.h"
+#include "test_wide.h"
 
 #ifdef CBVH_SANITIZE
 #define SCALE_DOWN 10
@@ -226,8 +227,8 @@ typedef struct {
     cbvh_scene s;
     cbvh_bvh b[2];
     cbvh_fbvh fb[2]; /* b[i] laid out for the plain float traversal */
-    cbvh_qbvh q[2];   /* b[i] collapsed 4-wide ... */
-    cbvh_fqbvh fq[2]; /* ... and laid out for its plain float traversal (leaf copy for b[0]) */
+    any_wide aw[2][2]; /* b[i] collapsed 4- and 8-wide (aw[W][i]) for the plain float traversals
+                        * (leaf copy for b[0]) */
     const char *bname[2];
     int nb;
     tree_cfg tr[MAX_TREES];
@@ -271,8 +272,8 @@ static int world_build(world *w, const tcfg *cfg, int ncfg, int both_builders) {
     }
     for (int bi = 0; bi < w->nb; bi++)
         if (cbvh_fbvh_build(&w->b[bi], &w->fb[bi], err, sizeof err) ||
-            cbvh_qbvh_from_bvh(&w->b[bi], &w->q[bi], err, sizeof err) ||
-            cbvh_fqbvh_build(&w->q[bi], bi ? NULL : w->s.tris, w->s.ntris, &w->fq[bi], err, sizeof err)) {
+            aw_build(&w->aw[0][bi], 0, &w->b[bi], bi ? NULL : w->s.tris, w->s.ntris, err, sizeof err) ||
+            aw_build(&w->aw[1][bi], 1, &w->b[bi], bi ? NULL : w->s.tris, w->s.ntris, err, sizeof err)) {
             FAIL("float BVH layouts: %s", err);
             return -1;
         }
@@ -307,8 +308,8 @@ static void world_free(world *w) {
     for (int i = 0; i < w->nt; i++) cbvh_tree_free(&w->tr[i].t);
     for (int i = 0; i < w->nb; i++) {
         cbvh_fbvh_free(&w->fb[i]);
-        cbvh_fqbvh_free(&w->fq[i]);
-        cbvh_qbvh_free(&w->q[i]);
+        aw_free(&w->aw[0][i]);
+        aw_free(&w->aw[1][i]);
         cbvh_bvh_free(&w->b[i]);
     }
     cbvh_scene_free(&w->s);
@@ -369,18 +370,20 @@ static cbvh_trav_hit check_ray(world *w, const cbvh_ray *r, int use_brute) {
             FAIL("plain float BVH %s any-hit %d prim %u, reference hit %d", w->bname[bi], any.hit, any.prim, ref.hit);
             print_ray("", r);
         }
-        /* ... and of its 4-wide collapse */
-        if (cbvh_trace_qbvh_float(&w->fq[bi], w->s.tris, r, CBVH_TRAV_CLOSEST, &h, &st) ||
-            cbvh_trace_qbvh_float(&w->fq[bi], w->s.tris, r, CBVH_TRAV_ANY, &any, &st)) {
-            FAIL("4-wide plain float %s rejected a valid ray", w->bname[bi]);
-            print_ray("", r);
-            continue;
-        }
-        w->checks++;
-        if (!same_hit(&h, &ref) || !any_ok(w, r, &any, ref.hit)) {
-            FAIL("4-wide plain float %s closest hit %d prim %u t %08X any %d != reference hit %d prim %u t %08X",
-                 w->bname[bi], h.hit, h.prim, h.t, any.hit, ref.hit, ref.prim, ref.t);
-            print_ray("", r);
+        /* ... and of its 4- and 8-wide collapses */
+        for (int W = 0; W < 2; W++) {
+            if (aw_trace(&w->aw[W][bi], w->s.tris, r, CBVH_TRAV_CLOSEST, &h, &st) ||
+                aw_trace(&w->aw[W][bi], w->s.tris, r, CBVH_TRAV_ANY, &any, &st)) {
+                FAIL("%s plain float %s rejected a valid ray", wide_name[W], w->bname[bi]);
+                print_ray("", r);
+                continue;
+            }
+            w->checks++;
+            if (!same_hit(&h, &ref) || !any_ok(w, r, &any, ref.hit)) {
+                FAIL("%s plain float %s closest hit %d prim %u t %08X any %d != reference hit %d prim %u t %08X",
+                     wide_name[W], w->bname[bi], h.hit, h.prim, h.t, any.hit, ref.hit, ref.prim, ref.t);
+                print_ray("", r);
+            }
         }
     }
     for (int i = 0; i < w->nt; i++) {
@@ -852,13 +855,14 @@ static long leak_rays(world *w, const mesh *m, long n, double inner_r, int cube)
                  i);
             print_ray("", &r);
         }
-        if (cbvh_trace_qbvh_float(&w->fq[0], w->s.tris, &r, (i & 3) ? CBVH_TRAV_ANY : CBVH_TRAV_CLOSEST, &hp, &sp) ||
-            !hp.hit) {
-            leaks++;
-            FAIL("closed_mesh_no_leaks: %s ray %ld leaked through the 4-wide plain float traversal",
-                 cube ? "cube" : "sphere", i);
-            print_ray("", &r);
-        }
+        for (int W = 0; W < 2; W++)
+            if (aw_trace(&w->aw[W][0], w->s.tris, &r, (i & 3) ? CBVH_TRAV_ANY : CBVH_TRAV_CLOSEST, &hp, &sp) ||
+                !hp.hit) {
+                leaks++;
+                FAIL("closed_mesh_no_leaks: %s ray %ld leaked through the %s plain float traversal",
+                     cube ? "cube" : "sphere", i, wide_name[W]);
+                print_ray("", &r);
+            }
         if (i % 997 == 0) check_ray(w, &r, i % (997 * 8) == 0); /* all structures; brute force on a subset */
     }
     return leaks;
@@ -1133,12 +1137,14 @@ static int case_nan_inf_rays(void) {
                     FAIL("nan_inf_rays: plain float BVH (mode %d) rc %d hit %d", mode, rc, h.hit);
                     print_ray("", &r);
                 }
-                memset(&h, 0xAB, sizeof h);
-                rc = cbvh_trace_qbvh_float(&w.fq[0], w.s.tris, &r, (cbvh_trav_mode)mode, &h, &ts);
-                if (rc != -1 || h.hit || h.prim || h.t || ts.box_tests || ts.tri_tests || ts.nodes || ts.bytes) {
-                    all_rejected = 0;
-                    FAIL("nan_inf_rays: 4-wide plain float (mode %d) rc %d hit %d", mode, rc, h.hit);
-                    print_ray("", &r);
+                for (int W = 0; W < 2; W++) {
+                    memset(&h, 0xAB, sizeof h);
+                    rc = aw_trace(&w.aw[W][0], w.s.tris, &r, (cbvh_trav_mode)mode, &h, &ts);
+                    if (rc != -1 || h.hit || h.prim || h.t || ts.box_tests || ts.tri_tests || ts.nodes || ts.bytes) {
+                        all_rejected = 0;
+                        FAIL("nan_inf_rays: %s plain float (mode %d) rc %d hit %d", wide_name[W], mode, rc, h.hit);
+                        print_ray("", &r);
+                    }
                 }
                 for (int t = 0; t < w.nt; t++) {
                     memset(&h, 0xAB, sizeof h);

@@ -29,6 +29,7 @@
 #include "cbvh/unit_table.h"
 #include "scene_load.h"
 #include "test_trav_util.h"
+#include "test_wide.h"
 
 #ifdef CBVH_SANITIZE
 #define RAYS 300
@@ -176,21 +177,22 @@ static void run_scene(const char *spec) {
         failures++;
         fb.nodes = NULL;
     }
-    /* the 4-wide plain float traversal, with and without the leaf copy */
-    cbvh_qbvh qb;
-    cbvh_fqbvh fq[2];
-    int have_fq = !cbvh_qbvh_from_bvh(&b, &qb, err, sizeof err);
-    if (have_fq && cbvh_fqbvh_build(&qb, s.tris, s.ntris, &fq[0], err, sizeof err)) have_fq = 0;
-    if (have_fq && cbvh_fqbvh_build(&qb, NULL, 0, &fq[1], err, sizeof err)) {
-        cbvh_fqbvh_free(&fq[0]);
-        have_fq = 0;
+    /* the 4- and 8-wide plain float traversals (W = 0, 1), with and without the leaf copy */
+    any_wide aw[2][2];
+    int have_w[2];
+    for (int W = 0; W < 2; W++) {
+        have_w[W] = !aw_build(&aw[W][0], W, &b, s.tris, s.ntris, err, sizeof err);
+        if (have_w[W] && aw_build(&aw[W][1], W, &b, NULL, 0, err, sizeof err)) {
+            aw_free(&aw[W][0]);
+            have_w[W] = 0;
+        }
+        if (!have_w[W] || !aw_leaf_tris(&aw[W][0]) || aw_leaf_tris(&aw[W][1]) || aw_leaf_src(&aw[W][0]) != s.tris) {
+            fprintf(stderr, "FAIL %s layout %s: %s\n", wide_name[W], spec, have_w[W] ? "leaf copy" : err);
+            failures++;
+        }
     }
-    if (!have_fq || !fq[0].leaf_tris || fq[1].leaf_tris || fq[0].leaf_src != s.tris) {
-        fprintf(stderr, "FAIL 4-wide layout %s: %s\n", spec, have_fq ? "leaf copy" : err);
-        failures++;
-    }
-    cbvh_trav_stats qs = {0};
-    long hits = 0, plain_mismatch = 0, wide_mismatch = 0;
+    cbvh_trav_stats ws[2] = {{0}, {0}};
+    long hits = 0, plain_mismatch = 0, wide_mismatch[2] = {0, 0};
     for (int i = 0; i < RAYS; i++) {
         rays[i] = box_ray(&rs, lo, hi, i, edge_on);
         cbvh_trav_hit any;
@@ -210,17 +212,18 @@ static void run_scene(const char *spec) {
             pa.hit != ref[i].hit) {
             if (plain_mismatch++ < 3) fprintf(stderr, "FAIL %s ray %d: plain float BVH != float BVH\n", spec, i);
         }
-        for (int k = 0; k < 2 && have_fq; k++) {
-            cbvh_trav_hit qh, qa;
-            cbvh_trav_stats qa1 = {0};
-            if (cbvh_trace_qbvh_float(&fq[k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &qh, k ? &qa1 : &qs) ||
-                cbvh_trace_qbvh_float(&fq[k], s.tris, &rays[i], CBVH_TRAV_ANY, &qa, &qa1) || !same_hit(&qh, &ref[i]) ||
-                qa.hit != ref[i].hit) {
-                if (wide_mismatch++ < 3)
-                    fprintf(stderr, "FAIL %s ray %d: 4-wide plain float (%s) != float BVH\n", spec, i,
-                            k ? "no leaf copy" : "leaf copy");
+        for (int W = 0; W < 2; W++)
+            for (int k = 0; k < 2 && have_w[W]; k++) {
+                cbvh_trav_hit qh, qa;
+                cbvh_trav_stats qa1 = {0};
+                if (aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &qh, k ? &qa1 : &ws[W]) ||
+                    aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_ANY, &qa, &qa1) || !same_hit(&qh, &ref[i]) ||
+                    qa.hit != ref[i].hit) {
+                    if (wide_mismatch[W]++ < 3)
+                        fprintf(stderr, "FAIL %s ray %d: %s plain float (%s) != float BVH\n", spec, i, wide_name[W],
+                                k ? "no leaf copy" : "leaf copy");
+                }
             }
-        }
         if (i < BRUTE) {
             cbvh_trav_hit bf = brute(&s, &rays[i]);
             if (!same_hit(&bf, &ref[i])) {
@@ -236,24 +239,30 @@ static void run_scene(const char *spec) {
            "mismatches %ld\n",
            spec, s.ntris, (double)ps.nodes / RAYS, (double)ps.box_tests / RAYS, (double)ps.tri_tests / RAYS,
            (double)ps.bytes / RAYS, plain_mismatch);
-    printf("%-22s %6u tris: 4-wide plain float   closest: %.1f nodes %.1f box %.1f tri %.0f B/ray; "
-           "mismatches %ld\n",
-           spec, s.ntris, (double)qs.nodes / RAYS, (double)qs.box_tests / RAYS, (double)qs.tri_tests / RAYS,
-           (double)qs.bytes / RAYS, wide_mismatch);
-    failures += plain_mismatch + wide_mismatch;
-    /* fewer nodes than the binary tree's, as many triangles within binary64 error */
-    if (have_fq && (qs.nodes >= ps.nodes || qs.nodes < ps.nodes / 4 || qs.bytes != qs.lines * CBVH_LINE_BYTES ||
-                    qs.tri_tests > ps.tri_tests + ps.tri_tests / 100 + 10)) {
-        fprintf(stderr, "FAIL %s: 4-wide counters: %llu nodes (binary %llu), %llu tri tests (binary %llu)\n", spec,
-                (unsigned long long)qs.nodes, (unsigned long long)ps.nodes, (unsigned long long)qs.tri_tests,
-                (unsigned long long)ps.tri_tests);
-        failures++;
+    failures += plain_mismatch;
+    /* fewer records than the binary (4-wide) or the 4-wide (8-wide) tree, as many triangles
+     * within binary64 error */
+    for (int W = 0; W < 2; W++) {
+        const cbvh_trav_stats *q = &ws[W], *fewer = W ? &ws[0] : &ps;
+        printf("%-22s %6u tris: %s plain float   closest: %.1f nodes %.1f box %.1f tri %.0f B/ray; "
+               "mismatches %ld\n",
+               spec, s.ntris, wide_name[W], (double)q->nodes / RAYS, (double)q->box_tests / RAYS,
+               (double)q->tri_tests / RAYS, (double)q->bytes / RAYS, wide_mismatch[W]);
+        failures += wide_mismatch[W];
+        if (have_w[W] && (q->nodes >= fewer->nodes || q->nodes < ps.nodes / (W ? 8 : 4) ||
+                          q->bytes != q->lines * CBVH_LINE_BYTES || q->tri_tests > ps.tri_tests + ps.tri_tests / 100 + 10)) {
+            fprintf(stderr, "FAIL %s: %s counters: %llu nodes (%s %llu), %llu tri tests (binary %llu)\n", spec,
+                    wide_name[W], (unsigned long long)q->nodes, W ? "4-wide" : "binary",
+                    (unsigned long long)fewer->nodes, (unsigned long long)q->tri_tests,
+                    (unsigned long long)ps.tri_tests);
+            failures++;
+        }
     }
-    if (have_fq) {
-        cbvh_fqbvh_free(&fq[0]);
-        cbvh_fqbvh_free(&fq[1]);
-        cbvh_qbvh_free(&qb);
-    }
+    for (int W = 0; W < 2; W++)
+        if (have_w[W]) {
+            aw_free(&aw[W][0]);
+            aw_free(&aw[W][1]);
+        }
     /* conservative within binary64 error: at most a few more boxes than the exact M = 24 unit */
     if (ps.box_tests > fs.box_tests + fs.box_tests / 100 || ps.box_tests < fs.box_tests / 2 ||
         ps.bytes != ps.lines * CBVH_LINE_BYTES) {
@@ -457,35 +466,34 @@ static void wide_layout_cases(void) {
                               {{0, 0, 0}, {1, 1, 0}, {0, 0}, 1, 1}};
     cbvh_bvh b3 = {nodes, 3, 0, prims, 2};
     char err[256] = "";
-    for (int k = 0; k < 2; k++) {
-        cbvh_qbvh q;
-        cbvh_fqbvh f;
-        cbvh_trav_hit hw, hu;
-        cbvh_trav_stats sw = {0}, su = {0};
-        const cbvh_bvh *b = k ? &b3 : &b1;
-        int ok = !cbvh_qbvh_from_bvh(b, &q, err, sizeof err) && !cbvh_fqbvh_build(&q, tri, 2, &f, err, sizeof err);
-        /* with two leaves the farther one (triangle 1) is culled after the nearer hit */
-        ok = ok && f.nnodes == (uint32_t)k && f.leaf_tris && f.leaf_tris[0].id == 1 &&
-             !cbvh_trace_qbvh_float(&f, tri, &r, CBVH_TRAV_CLOSEST, &hw, &sw) &&
-             !cbvh_trace_bvh(b, tri, &r, 24, CBVH_TRAV_CLOSEST, &hu, &su) && hw.hit && same_hit(&hw, &hu) &&
-             hw.prim == 0 && hw.t == fb(1) && sw.tri_tests == (k ? 1u : 2u) && sw.nodes == (uint64_t)k &&
-             sw.box_tests == 1 + 2 * (uint64_t)k;
-        if (ok && k) /* the root's record: two leaf children, slots 2 and 3 empty */
-            ok = f.nodes[0].valid == 3 && f.nodes[0].child[1] == (CBVH_FQBVH_LEAF | 1u) && f.nodes[0].count[1] == 1;
-        if (ok) { /* another triangle array (triangle 0 moved): read, not the copy */
-            cbvh_tri moved[2] = {tri[0], tri[1]};
-            for (int v = 0; v < 3; v++) moved[0].v[v][2] = -0.5f;
-            ok = !cbvh_trace_qbvh_float(&f, moved, &r, CBVH_TRAV_CLOSEST, &hw, &sw) && hw.hit && hw.prim == 0 &&
-                 hw.t == fb(1.5f);
+    for (int W = 0; W < 2; W++) /* both layouts: 4- and 8-wide */
+        for (int k = 0; k < 2; k++) {
+            any_wide f;
+            cbvh_trav_hit hw = {0}, hu;
+            cbvh_trav_stats sw = {0}, su = {0};
+            const cbvh_bvh *b = k ? &b3 : &b1;
+            int ok = !aw_build(&f, W, b, tri, 2, err, sizeof err);
+            /* with two leaves the farther one (triangle 1) is culled after the nearer hit */
+            ok = ok && aw_nrecs(&f) == (uint32_t)k && aw_leaf_tris(&f) && aw_leaf_tris(&f)[0].id == 1 &&
+                 !aw_trace(&f, tri, &r, CBVH_TRAV_CLOSEST, &hw, &sw) &&
+                 !cbvh_trace_bvh(b, tri, &r, 24, CBVH_TRAV_CLOSEST, &hu, &su) && hw.hit && same_hit(&hw, &hu) &&
+                 hw.prim == 0 && hw.t == fb(1) && sw.tri_tests == (k ? 1u : 2u) && sw.nodes == (uint64_t)k &&
+                 sw.box_tests == 1 + 2 * (uint64_t)k && sw.lines == su.lines - (uint64_t)k + (uint64_t)k * (W ? 4 : 2);
+            if (ok && k) /* the root's record: two leaf children, the other slots empty */
+                ok = aw_valid(&f, 0) == 3 && aw_child(&f, 0, 1) == (CBVH_FQBVH_LEAF | 1u) && aw_count(&f, 0, 1) == 1;
+            if (ok) { /* another triangle array (triangle 0 moved): read, not the copy */
+                cbvh_tri moved[2] = {tri[0], tri[1]};
+                for (int v = 0; v < 3; v++) moved[0].v[v][2] = -0.5f;
+                ok = !aw_trace(&f, moved, &r, CBVH_TRAV_CLOSEST, &hw, &sw) && hw.hit && hw.prim == 0 &&
+                     hw.t == fb(1.5f);
+            }
+            if (!ok) {
+                fprintf(stderr, "FAIL %s layout of a %d-node tree: hit %d prim %u t %08X (%s)\n", wide_name[W],
+                        k ? 3 : 1, hw.hit, hw.prim, hw.t, err);
+                failures++;
+            }
+            aw_free(&f);
         }
-        if (!ok) {
-            fprintf(stderr, "FAIL 4-wide layout of a %d-node tree: hit %d prim %u t %08X (%s)\n", k ? 3 : 1, hw.hit,
-                    hw.prim, hw.t, err);
-            failures++;
-        }
-        cbvh_fqbvh_free(&f);
-        cbvh_qbvh_free(&q);
-    }
     /* A chain of 4-child nodes, all boxes [0, 1]^2 x [-1, 0]: each level defers its three leaves
      * (ties: slot 0, the next level, first), so the stack grows by 3 a level: depth 20 fits
      * (max_stack 3 * 20 + 1, 20 nodes), depth 100 overflows (-1); a ray missing the root
@@ -557,6 +565,115 @@ static void wide_layout_cases(void) {
         failures++;
     }
     cbvh_fqbvh_free(&f);
+}
+
+/* The 8-wide layout (docs/traversal.md §14; the one-leaf and two-leaf trees
+ * are wide_layout_cases'): a complete binary tree of depth 3 collapsed into
+ * one record of eight leaves, a depth-4 tree of ties, and malformed binary
+ * BVHs refused with their reason. */
+static void wide8_layout_cases(void) {
+    cbvh_tri tri[8] = {{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}}};
+    for (int i = 1; i < 8; i++) /* triangles 1..7 below triangle 0 */
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++) tri[i].v[v][a] = a < 2 ? tri[0].v[v][a] : -(float)i;
+    cbvh_ray r = {{fb(0.25f), fb(0.25f), fb(1)}, {0, CBVH_F32_SIGN, fb(-1)}, 0, CBVH_F32_POS_INF};
+    uint32_t prims[8] = {1, 0, 2, 3, 4, 5, 6, 7};
+    char err[256] = "";
+    /* complete binary tree of depth 3: inner nodes 0..6 (children 2i + 1, 2i + 2), leaves 7..14
+     * with one triangle each; leaf j's box encloses triangle prims[j - 7] */
+    cbvh_bvh_node full[15];
+    for (uint32_t i = 0; i < 15; i++) {
+        cbvh_bvh_node n = {{0, 0, -7}, {1, 1, 0}, {0, 0}, 0, 0};
+        if (i < 7) {
+            n.child[0] = 2 * i + 1;
+            n.child[1] = 2 * i + 2;
+        } else {
+            n.first = i - 7;
+            n.count = 1;
+            float z = tri[prims[i - 7]].v[0][2];
+            n.lo[2] = n.hi[2] = z;
+        }
+        full[i] = n;
+    }
+    cbvh_bvh b15 = {full, 15, 0, prims, 8};
+    cbvh_f8bvh f;
+    cbvh_trav_hit hw = {0}, hu = {0};
+    cbvh_trav_stats sw = {0}, su = {0};
+    int ok = !cbvh_f8bvh_build(&b15, NULL, 0, &f, err, sizeof err) && f.nnodes == 1 && f.nodes[0].valid == 255 &&
+             !cbvh_trace_f8bvh_float(&f, tri, &r, CBVH_TRAV_CLOSEST, &hw, &sw) &&
+             !cbvh_trace_bvh(&b15, tri, &r, 24, CBVH_TRAV_CLOSEST, &hu, &su) && same_hit(&hw, &hu) && hw.prim == 0 &&
+             sw.nodes == 1 && sw.box_tests == 9 && sw.tri_tests == 1;
+    for (int c = 0; ok && c < 8; c++) /* slots in the binary tree's left-to-right order */
+        ok = f.nodes[0].child[c] == (CBVH_F8BVH_LEAF | (uint32_t)c) && f.nodes[0].count[c] == 1 &&
+             f.nodes[0].pl[(0 * 3 + 2) * 8 + c] == tri[prims[c]].v[0][2];
+    if (!ok) {
+        fprintf(stderr, "FAIL 8-wide collapse of a depth-3 tree: hit %d prim %u, %llu box tests (%s)\n", hw.hit,
+                hw.prim, (unsigned long long)sw.box_tests, err);
+        failures++;
+    }
+    cbvh_f8bvh_free(&f);
+    /* malformed: a child outside the BVH, a child back to the root, a leaf past the IDs, a leaf too large */
+    static uint32_t many[70000];
+    struct {
+        uint32_t node, child0, first, count;
+        const char *why;
+    } bad[] = {{0, 99, 0, 0, "outside the BVH"},
+               {1, 0, 0, 0, "reached twice"},
+               {9, 0, 8, 1, "out of bounds"},
+               {9, 0, 0, 65536, "above 65535"}};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        cbvh_bvh_node keep = full[bad[i].node];
+        if (bad[i].count) {
+            full[bad[i].node].first = bad[i].first;
+            full[bad[i].node].count = bad[i].count;
+        } else {
+            full[bad[i].node].child[0] = bad[i].child0;
+        }
+        cbvh_bvh bb = {full, 15, 0, bad[i].count == 65536 ? many : prims, bad[i].count == 65536 ? 70000 : 8};
+        err[0] = 0;
+        if (cbvh_f8bvh_build(&bb, NULL, 0, &f, err, sizeof err) != -1 || !strstr(err, bad[i].why) || f.nodes) {
+            fprintf(stderr, "FAIL 8-wide layout accepted bad BVH %zu (%s)\n", i, err);
+            failures++;
+        }
+        full[bad[i].node] = keep;
+    }
+    /* Complete binary tree of depth 4, all boxes equal (every choice a tie): the leftmost
+     * inner child is opened first, so the root's record holds leaves 15..20, then inner
+     * node 10 and inner node 2 (records 1 and 2: depth-first, 10's before 2's); a direct
+     * child of a later record (node 10's) that is already in the root's record is refused. */
+    cbvh_bvh_node deep[31];
+    static uint32_t prims16[16];
+    for (uint32_t i = 0; i < 31; i++) {
+        cbvh_bvh_node n = {{0, 0, -7}, {1, 1, 0}, {0, 0}, 0, 0};
+        if (i < 15) {
+            n.child[0] = 2 * i + 1;
+            n.child[1] = 2 * i + 2;
+        } else {
+            n.first = prims16[i - 15] = i - 15;
+            n.count = 1;
+        }
+        deep[i] = n;
+    }
+    cbvh_bvh b31 = {deep, 31, 0, prims16, 16};
+    ok = !cbvh_f8bvh_build(&b31, NULL, 0, &f, err, sizeof err) && f.nnodes == 3 && f.nodes[0].valid == 255 &&
+         f.nodes[0].child[6] == 1 && f.nodes[0].child[7] == 2 && f.nodes[1].valid == 3 && f.nodes[2].valid == 255;
+    for (int c = 0; ok && c < 6; c++) ok = f.nodes[0].child[c] == (CBVH_F8BVH_LEAF | (uint32_t)c);
+    for (int c = 0; ok && c < 8; c++) ok = f.nodes[2].child[c] == (CBVH_F8BVH_LEAF | (uint32_t)(8 + c));
+    if (!ok) {
+        fprintf(stderr, "FAIL 8-wide collapse of a depth-4 tree of ties: %u records (%s)\n", f.nnodes, err);
+        failures++;
+    }
+    cbvh_f8bvh_free(&f);
+    deep[10].child[0] = 15;
+    if (cbvh_f8bvh_build(&b31, NULL, 0, &f, err, sizeof err) != -1 || !strstr(err, "reached twice")) {
+        fprintf(stderr, "FAIL 8-wide layout accepted a leaf reached twice (%s)\n", err);
+        failures++;
+    }
+    cbvh_bvh broot = {full, 15, 15, prims, 8};
+    if (cbvh_f8bvh_build(&broot, NULL, 0, &f, err, sizeof err) != -1 || !strstr(err, "supported")) {
+        fprintf(stderr, "FAIL 8-wide layout accepted a root outside the BVH (%s)\n", err);
+        failures++;
+    }
 }
 
 /* A one-pair CBVH over [0, 1]^3 (N = 6, relative codes): child 0 with the
@@ -759,6 +876,7 @@ int main(void) {
     bad_rays();
     layout_cases();
     wide_layout_cases();
+    wide8_layout_cases();
     cyclic_cbvh();
     decoded_malformed();
     decoded_leaves();
