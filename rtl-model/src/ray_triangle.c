@@ -168,17 +168,21 @@ void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p) {
     p->ok = !bad && !(cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]));
 }
 
+/* kx, ky for kz and the sign of d_kz: cyclic after kz, swapped when d_kz < 0 */
+static const uint8_t perm_xy[3][2][2] = {{{1, 2}, {2, 1}}, {{2, 0}, {0, 2}}, {{0, 1}, {1, 0}}};
+
 void cbvh_tri_ray_prepare_valid(const cbvh_ray *ray, cbvh_tri_ray *p) {
     p->ok = 1;
-    int kz = 0;
-    for (int a = 1; a < 3; a++)
-        if ((ray->d[a] & ~CBVH_F32_SIGN) > (ray->d[kz] & ~CBVH_F32_SIGN)) kz = a;
-    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-    if (ray->d[kz] & CBVH_F32_SIGN) {
-        int t = kx;
-        kx = ky;
-        ky = t;
-    }
+    /* The exact path's permutation (kz = the largest |d|, the first on ties)
+     * chosen with selects, not branches: the choice is a coin toss per ray
+     * (about one mispredicted branch per traversal before). */
+    uint32_t m0 = ray->d[0] & ~CBVH_F32_SIGN, m1 = ray->d[1] & ~CBVH_F32_SIGN, m2 = ray->d[2] & ~CBVH_F32_SIGN;
+    int c1 = m1 > m0;
+    uint32_t m01 = c1 ? m1 : m0;
+    int c2 = m2 > m01;
+    int kz = (c1 | c2 << 1) - (c1 & c2); /* c2 ? 2 : c1, as arithmetic (a select became a branch) */
+    int neg = (int)(ray->d[kz] >> 31);
+    int kx = perm_xy[kz][neg][0], ky = perm_xy[kz][neg][1];
     p->kx = kx;
     p->ky = ky;
     p->kz = kz;
