@@ -106,7 +106,8 @@ int cbvh_qbvh_from_bvh(const cbvh_bvh *b, cbvh_qbvh *out, char *err, size_t errl
         uint32_t ch[4];
         int k = cbvh_collapse_gather(b, src[i], 4, ch, NULL);
         if (k < 0 || q.nnodes > cap - (uint32_t)k) {
-            snprintf(err, errlen, "qbvh: binary BVH is not a tree (a child outside it, or more nodes reached than it has)");
+            snprintf(err, errlen,
+                     "qbvh: binary BVH is not a tree (a child outside it, or more nodes reached than it has)");
             goto fail;
         }
         q.first[i] = q.nnodes;

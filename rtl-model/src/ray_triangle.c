@@ -19,6 +19,25 @@
 #include "fast_paths.h"
 #include "ray_prep.h"
 
+/* kx, ky for kz and the sign of d_kz: cyclic after kz, swapped when d_kz < 0 */
+static const uint8_t perm_xy[3][2][2] = {{{1, 2}, {2, 1}}, {{2, 0}, {0, 2}}, {{0, 1}, {1, 0}}};
+
+/* Axis permutation: kz = largest |d| (first on ties), kx, ky follow
+ * cyclically and swap when d_kz < 0 (keeps the winding, as in the paper).
+ * Chosen with compares and bit arithmetic, not branches: the choice is a
+ * coin toss per ray (a select became a branch, hence the arithmetic). */
+static void tri_axes(const cbvh_ray *ray, int *kx, int *ky, int *kz) {
+    uint32_t m0 = ray->d[0] & ~CBVH_F32_SIGN, m1 = ray->d[1] & ~CBVH_F32_SIGN, m2 = ray->d[2] & ~CBVH_F32_SIGN;
+    int c1 = m1 > m0;
+    uint32_t m01 = c1 ? m1 : m0;
+    int c2 = m2 > m01;
+    int z = (c1 | c2 << 1) - (c1 & c2); /* c2 ? 2 : c1 */
+    int neg = (int)(ray->d[z] >> 31);
+    *kx = perm_xy[z][neg][0];
+    *ky = perm_xy[z][neg][1];
+    *kz = z;
+}
+
 uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3],
                                       const cbvh_f32 v2[3], cbvh_tri_result *out) {
     memset(out, 0, sizeof *out);
@@ -30,17 +49,8 @@ uint32_t cbvh_ray_triangle_exact_only(const cbvh_ray *ray, const cbvh_f32 v0[3],
     if (cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]))
         return CBVH_ST_ZERO_DIR;
 
-    /* Axis permutation: kz = largest |d| (first on ties), kx, ky follow
-     * cyclically and swap when d_kz < 0 (keeps the winding, as in the paper). */
-    int kz = 0;
-    for (int a = 1; a < 3; a++)
-        if ((ray->d[a] & ~CBVH_F32_SIGN) > (ray->d[kz] & ~CBVH_F32_SIGN)) kz = a;
-    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-    if (ray->d[kz] & CBVH_F32_SIGN) {
-        int t = kx;
-        kx = ky;
-        ky = t;
-    }
+    int kx, ky, kz;
+    tri_axes(ray, &kx, &ky, &kz);
     cbvh_xw dx, dy, dz;
     cbvh_xw_from_f32(&dx, ray->d[kx]);
     cbvh_xw_from_f32(&dy, ray->d[ky]);
@@ -168,21 +178,10 @@ void cbvh_tri_ray_prepare(const cbvh_ray *ray, cbvh_tri_ray *p) {
     p->ok = !bad && !(cbvh_f32_is_zero(ray->d[0]) && cbvh_f32_is_zero(ray->d[1]) && cbvh_f32_is_zero(ray->d[2]));
 }
 
-/* kx, ky for kz and the sign of d_kz: cyclic after kz, swapped when d_kz < 0 */
-static const uint8_t perm_xy[3][2][2] = {{{1, 2}, {2, 1}}, {{2, 0}, {0, 2}}, {{0, 1}, {1, 0}}};
-
 void cbvh_tri_ray_prepare_valid(const cbvh_ray *ray, cbvh_tri_ray *p) {
     p->ok = 1;
-    /* The exact path's permutation (kz = the largest |d|, the first on ties)
-     * chosen with selects, not branches: the choice is a coin toss per ray
-     * (about one mispredicted branch per traversal before). */
-    uint32_t m0 = ray->d[0] & ~CBVH_F32_SIGN, m1 = ray->d[1] & ~CBVH_F32_SIGN, m2 = ray->d[2] & ~CBVH_F32_SIGN;
-    int c1 = m1 > m0;
-    uint32_t m01 = c1 ? m1 : m0;
-    int c2 = m2 > m01;
-    int kz = (c1 | c2 << 1) - (c1 & c2); /* c2 ? 2 : c1, as arithmetic (a select became a branch) */
-    int neg = (int)(ray->d[kz] >> 31);
-    int kx = perm_xy[kz][neg][0], ky = perm_xy[kz][neg][1];
+    int kx, ky, kz; /* the exact path's axes */
+    tri_axes(ray, &kx, &ky, &kz);
     p->kx = kx;
     p->ky = ky;
     p->kz = kz;
