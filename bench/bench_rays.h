@@ -80,9 +80,13 @@ static inline void bench_parse(int argc, char **argv, bench_args *a, const char 
             if (!ok) die("--embree-isa", "must be sse2, sse4.2, avx, avx2 or avx512");
         } else if (!strcmp(argv[i], "--embree-robust")) {
             a->robust = 1;
+        } else if (!strcmp(argv[i], "--wide-isa") && i + 1 < argc) { /* cap the wide float traversals' ISA */
+            const char *w = argv[++i];
+            if (strcmp(w, "base") && strcmp(w, "avx")) die("--wide-isa", "must be base or avx");
+            cbvh_wide_float_limit_isa(strcmp(w, "avx") ? CBVH_WIDE_ISA_BASE : CBVH_WIDE_ISA_AVX);
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: " BENCH_NAME
-                            " [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]\n");
+            fprintf(stderr, "usage: " BENCH_NAME " [--rays R] [--seed S] [--reps K] [--embree-isa ISA] "
+                            "[--embree-robust] [--wide-isa base|avx] [SCENE...]\n");
             exit(2);
         } else if (a->ns < 64) {
             a->specs[a->ns++] = argv[i];

@@ -14,7 +14,8 @@
  *     test in eight lanes (cbvh_trace_f8bvh_float), likewise checked,
  * closest hit and any hit, one core, as ratios to Embree.
  *
- * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust] [SCENE...]
+ * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust]
+ *                       [--wide-isa base|avx] [SCENE...]
  *   SCENE as for `cbvh study` (mesh file or proc:NAME[:SIZE]); default: the
  *   bundled bunny.  R rays per kind (default 20000): camera rays (pinhole, a
  *   square image looking at the scene centre from outside its box) and random
@@ -25,7 +26,10 @@
  * calling thread for every tracer.  --embree-isa limits Embree to one
  * instruction set (Embree's "isa=" setting: sse2, sse4.2, avx, avx2, avx512);
  * by default it picks the widest the CPU has, while our code is built for the
- * x86-64 baseline (SSE2), so sse2 compares like with like.  --embree-robust
+ * x86-64 baseline (SSE2), so sse2 compares like with like; only the wide
+ * float traversals (4- and 8-wide) also run an AVX build of their loop on
+ * CPUs with AVX, which --wide-isa base turns off (the ISA in use is printed
+ * first).  --embree-robust
  * builds Embree's scenes in its robust mode (RTC_SCENE_FLAG_ROBUST): ours
  * never miss (conservative boxes, exact triangles), Embree's default mode may. */
 #define _POSIX_C_SOURCE 200809L
@@ -114,6 +118,7 @@ int main(int argc, char **argv) {
     printf("(built without Embree: no baseline, absolute rays/s only)\n");
 #endif
     char err[512];
+    printf("# wide float traversals' box test: %s\n", cbvh_wide_isa_name(cbvh_wide_float_isa()));
     printf("%-24s %7s %-12s %11s %11s %11s %11s %11s %11s %8s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s "
            "%7s %7s %7s %11s %8s %7s %7s\n",
            "scene", "tris", "kind", "embree_r/s", "float_r/s", "bvh_r/s", "cbvh_r/s", "cbvhd_r/s", "flt4_r/s",

@@ -26,6 +26,12 @@
 #else
 #define CBVH_REF_SSE2 0
 #endif
+#if CBVH_REF_SSE2 && defined(__AVX__)
+#define CBVH_REF_AVX 1
+#include <immintrin.h>
+#else
+#define CBVH_REF_AVX 0
+#endif
 
 #define CBVH_REF_EPS 0x1p-50 /* > 2 * 3.0000001 * 2^-53 */
 
@@ -166,7 +172,18 @@ static inline int cbvh_ref_boxw_c(const cbvh_ref_ray *r, const float *box, int w
  * lane by lane the same operations, so the same results as cbvh_ref_box2_c
  * on any two of them.  Returns the hit mask (bit c for box c). */
 static inline int cbvh_ref_box4(const cbvh_ref_ray *r, const float box[24], double cull, double t_lo[4]) {
-#if CBVH_REF_SSE2
+#if CBVH_REF_AVX
+    __m256d n = _mm256_set1_pd(r->tmin), f = _mm256_set1_pd(cull);
+    for (int a = 0; a < 3; a++) {
+        __m256d o = _mm256_set1_pd(r->o[a]), inv = _mm256_set1_pd(r->inv[a]);
+        __m256d pn = _mm256_cvtps_pd(_mm_loadu_ps(box + r->pn4[a]));
+        __m256d pf = _mm256_cvtps_pd(_mm_loadu_ps(box + r->pf4[a]));
+        n = _mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(pn, o), inv), n);
+        f = _mm256_min_pd(_mm256_mul_pd(_mm256_sub_pd(pf, o), inv), f);
+    }
+    _mm256_storeu_pd(t_lo, _mm256_mul_pd(n, _mm256_set1_pd(1 - CBVH_REF_EPS)));
+    return _mm256_movemask_pd(_mm256_cmp_pd(n, _mm256_mul_pd(f, _mm256_set1_pd(1 + CBVH_REF_EPS)), _CMP_LE_OS));
+#elif CBVH_REF_SSE2
     __m128d n01 = _mm_set1_pd(r->tmin), n23 = n01, f01 = _mm_set1_pd(cull), f23 = f01;
     for (int a = 0; a < 3; a++) { /* lanes c, c + 1 of a plane row: two binary32 widened */
         const float *pn = box + r->pn4[a], *pf = box + r->pf4[a];
@@ -195,7 +212,22 @@ static inline int cbvh_ref_box4(const cbvh_ref_ray *r, const float box[24], doub
  * register pair k, the same operations per box as cbvh_ref_box2_c.  Returns
  * the hit mask (bit c for box c). */
 static inline int cbvh_ref_box8(const cbvh_ref_ray *r, const float box[48], double cull, double t_lo[8]) {
-#if CBVH_REF_SSE2
+#if CBVH_REF_AVX
+    __m256d n0 = _mm256_set1_pd(r->tmin), n1 = n0, f0 = _mm256_set1_pd(cull), f1 = f0;
+    for (int a = 0; a < 3; a++) {
+        const float *pn = box + 2 * r->pn4[a], *pf = box + 2 * r->pf4[a];
+        __m256d o = _mm256_set1_pd(r->o[a]), inv = _mm256_set1_pd(r->inv[a]);
+        n0 = _mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(pn)), o), inv), n0);
+        n1 = _mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(pn + 4)), o), inv), n1);
+        f0 = _mm256_min_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(pf)), o), inv), f0);
+        f1 = _mm256_min_pd(_mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(pf + 4)), o), inv), f1);
+    }
+    __m256d lo = _mm256_set1_pd(1 - CBVH_REF_EPS), hi = _mm256_set1_pd(1 + CBVH_REF_EPS);
+    _mm256_storeu_pd(t_lo, _mm256_mul_pd(n0, lo));
+    _mm256_storeu_pd(t_lo + 4, _mm256_mul_pd(n1, lo));
+    return _mm256_movemask_pd(_mm256_cmp_pd(n0, _mm256_mul_pd(f0, hi), _CMP_LE_OS)) |
+           _mm256_movemask_pd(_mm256_cmp_pd(n1, _mm256_mul_pd(f1, hi), _CMP_LE_OS)) << 4;
+#elif CBVH_REF_SSE2
     __m128d n[4], f[4];
     for (int k = 0; k < 4; k++) {
         n[k] = _mm_set1_pd(r->tmin);

@@ -16,5 +16,5 @@ int cbvh_trace_f8bvh_float(const cbvh_f8bvh *f, const cbvh_tri *tris, const cbvh
                            cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     const wide_tree w = {(const unsigned char *)f->nodes, f->nnodes, f->root, f->root_count,
                          f->root_box, f->leaf_tris, f->leaf_src, f->prims, f->nprims};
-    return wide_trace(8, &w, tris, ray, mode, hit, st);
+    return wide_trace_isa(8, &w, tris, ray, mode, hit, st);
 }

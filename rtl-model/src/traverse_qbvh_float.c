@@ -113,5 +113,5 @@ int cbvh_trace_qbvh_float(const cbvh_fqbvh *f, const cbvh_tri *tris, const cbvh_
                           cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     const wide_tree w = {(const unsigned char *)f->nodes, f->nnodes, f->root, f->root_count,
                          f->root_box, f->leaf_tris, f->leaf_src, f->q->prims, f->q->nprims};
-    return wide_trace(4, &w, tris, ray, mode, hit, st);
+    return wide_trace_isa(4, &w, tris, ray, mode, hit, st);
 }

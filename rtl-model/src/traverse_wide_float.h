@@ -146,4 +146,24 @@ static inline int wide_trace(int W, const wide_tree *f, const cbvh_tri *tris, co
     return 0;
 }
 
+/* The loop compiled for AVX (traverse_wide_float_avx.c, built with -mavx
+ * where the compiler targets x86-64 and defines CBVH_WIDE_AVX) for W = 4
+ * and 8, and the choice between it and this build's (wide_isa.c). */
+#ifdef CBVH_WIDE_AVX
+int cbvh_wide_trace_avx4(const wide_tree *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
+                         cbvh_trav_hit *hit, cbvh_trav_stats *st);
+int cbvh_wide_trace_avx8(const wide_tree *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
+                         cbvh_trav_hit *hit, cbvh_trav_stats *st);
+#endif
+
+static inline int wide_trace_isa(int W, const wide_tree *f, const cbvh_tri *tris, const cbvh_ray *ray,
+                                 cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st) {
+#ifdef CBVH_WIDE_AVX
+    if (cbvh_wide_float_isa() == CBVH_WIDE_ISA_AVX)
+        return W == 4 ? cbvh_wide_trace_avx4(f, tris, ray, mode, hit, st)
+                      : cbvh_wide_trace_avx8(f, tris, ray, mode, hit, st);
+#endif
+    return wide_trace(W, f, tris, ray, mode, hit, st);
+}
+
 #endif

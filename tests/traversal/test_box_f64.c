@@ -16,7 +16,9 @@
  *     the eight-box cbvh_ref_box8 equal the plain C cbvh_ref_box2_c bit for
  *     bit on every box (whose conservativeness tests/traversal/test_ray_box.c
  *     checks against exact rationals), and the general variant on four and
- *     eight boxes equals it on two;
+ *     eight boxes equals it on two; test_box_f64_avx is the same test
+ *     compiled with -mavx, where box4 and box8 use AVX's four-lane registers
+ *     (the wide float traversals' AVX loop, docs/traversal.md §15);
  *   - and the filter decides nearly all scene-like inputs (so the comparison
  *     is not vacuous and the speed-up is real).
  * Inputs: random values over wide exponent ranges plus hard cases - plane
@@ -587,7 +589,7 @@ static void test_ref_lanes(void) {
     }
     printf("plain float slab test: %ld rays x 4 boxes (%ld general, %ld culled just below an entry), %ld box hits; "
            "eight-, four- and two-box lanes (%s) equal the plain C\n",
-           n, ngeneral, n_margin, nhit, CBVH_REF_SSE2 ? "SSE2" : "plain C");
+           n, ngeneral, n_margin, nhit, CBVH_REF_AVX ? "AVX" : CBVH_REF_SSE2 ? "SSE2" : "plain C");
     if (n < NBOX / 2 || ngeneral < n / 20 || n_margin < n / 200 || nhit < n / 4 || nhit > 3 * n) {
         printf("FAIL: plain float lane test inputs not varied enough\n");
         failures++;
@@ -595,6 +597,12 @@ static void test_ref_lanes(void) {
 }
 
 int main(void) {
+#if CBVH_REF_AVX && defined(__GNUC__)
+    if (!__builtin_cpu_supports("avx")) {
+        printf("skipped: built with AVX lanes, and this CPU has no AVX\n");
+        return 77;
+    }
+#endif
     test_ref_lanes();
     test_float_boxes();
     test_filter_margin();

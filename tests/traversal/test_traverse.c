@@ -192,7 +192,15 @@ static void run_scene(const char *spec) {
         }
     }
     cbvh_trav_stats ws[2] = {{0}, {0}};
-    long hits = 0, plain_mismatch = 0, wide_mismatch[2] = {0, 0};
+    long hits = 0, plain_mismatch = 0, wide_mismatch[2] = {0, 0}, isa_mismatch[2] = {0, 0}, isa_rays[2] = {0, 0};
+    const cbvh_wide_isa isa = cbvh_wide_float_isa();
+#ifdef CBVH_WIDE_AVX /* the library has the AVX loop: a CPU with AVX runs it */
+    if (__builtin_cpu_supports("avx") && isa != CBVH_WIDE_ISA_AVX) {
+        fprintf(stderr, "FAIL: this CPU has AVX, but the wide float traversals run the %s loop\n",
+                cbvh_wide_isa_name(isa));
+        failures++;
+    }
+#endif
     for (int i = 0; i < RAYS; i++) {
         rays[i] = box_ray(&rs, lo, hi, i, edge_on);
         cbvh_trav_hit any;
@@ -215,13 +223,31 @@ static void run_scene(const char *spec) {
         for (int W = 0; W < 2; W++)
             for (int k = 0; k < 2 && have_w[W]; k++) {
                 cbvh_trav_hit qh, qa;
-                cbvh_trav_stats qa1 = {0};
-                if (aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &qh, k ? &qa1 : &ws[W]) ||
+                cbvh_trav_stats qc1 = {0}, qa1 = {0};
+                if (aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &qh, &qc1) ||
                     aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_ANY, &qa, &qa1) || !same_hit(&qh, &ref[i]) ||
                     qa.hit != ref[i].hit) {
                     if (wide_mismatch[W]++ < 3)
                         fprintf(stderr, "FAIL %s ray %d: %s plain float (%s) != float BVH\n", spec, i, wide_name[W],
                                 k ? "no leaf copy" : "leaf copy");
+                }
+                if (!k) add_stats(&ws[W], &qc1);
+                /* the AVX build of the loop (where it runs) against the baseline's: the same
+                 * hit and counters, so the same visits */
+                if (isa != CBVH_WIDE_ISA_BASE) {
+                    cbvh_trav_hit bh, ba;
+                    cbvh_trav_stats bc1 = {0}, ba1 = {0};
+                    cbvh_wide_float_limit_isa(CBVH_WIDE_ISA_BASE);
+                    int rc = aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &bh, &bc1) ||
+                             aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_ANY, &ba, &ba1);
+                    cbvh_wide_float_limit_isa(isa);
+                    if (rc || memcmp(&bh, &qh, sizeof bh) || memcmp(&ba, &qa, sizeof ba) ||
+                        memcmp(&bc1, &qc1, sizeof bc1) || memcmp(&ba1, &qa1, sizeof ba1)) {
+                        if (isa_mismatch[W]++ < 3)
+                            fprintf(stderr, "FAIL %s ray %d: %s plain float, %s loop != baseline loop\n", spec, i,
+                                    wide_name[W], cbvh_wide_isa_name(isa));
+                    }
+                    isa_rays[W]++;
                 }
             }
         if (i < BRUTE) {
@@ -245,10 +271,11 @@ static void run_scene(const char *spec) {
     for (int W = 0; W < 2; W++) {
         const cbvh_trav_stats *q = &ws[W], *fewer = W ? &ws[0] : &ps;
         printf("%-22s %6u tris: %s plain float   closest: %.1f nodes %.1f box %.1f tri %.0f B/ray; "
-               "mismatches %ld\n",
+               "mismatches %ld; %s loop vs baseline: %ld rays x 2 layouts, %ld differ\n",
                spec, s.ntris, wide_name[W], (double)q->nodes / RAYS, (double)q->box_tests / RAYS,
-               (double)q->tri_tests / RAYS, (double)q->bytes / RAYS, wide_mismatch[W]);
-        failures += wide_mismatch[W];
+               (double)q->tri_tests / RAYS, (double)q->bytes / RAYS, wide_mismatch[W], cbvh_wide_isa_name(isa),
+               isa_rays[W] / 2, isa_mismatch[W]);
+        failures += wide_mismatch[W] + isa_mismatch[W];
         if (have_w[W] && (q->nodes >= fewer->nodes || q->nodes < ps.nodes / (W ? 8 : 4) ||
                           q->bytes != q->lines * CBVH_LINE_BYTES || q->tri_tests > ps.tri_tests + ps.tri_tests / 100 + 10)) {
             fprintf(stderr, "FAIL %s: %s counters: %llu nodes (%s %llu), %llu tri tests (binary %llu)\n", spec,

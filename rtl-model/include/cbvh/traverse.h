@@ -91,6 +91,18 @@ void cbvh_fbvh_free(cbvh_fbvh *f);
 int cbvh_trace_bvh_float(const cbvh_fbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
                          cbvh_trav_hit *hit, cbvh_trav_stats *st);
 
+/* The instruction set of the wide float traversals' box tests
+ * (cbvh_trace_qbvh_float, cbvh_trace_f8bvh_float; docs/traversal.md §15):
+ * AVX when the library was built for x86-64 by GCC or Clang and the CPU
+ * and OS support it, else the baseline (SSE2 or plain C).  Both run the same
+ * binary64 operations per box, so hits, counters and visiting order are the
+ * same.  cbvh_wide_float_limit_isa caps the choice (tests and benchmarks
+ * compare the two; call it before tracing, not while other threads trace). */
+typedef enum { CBVH_WIDE_ISA_BASE = 0, CBVH_WIDE_ISA_AVX = 1 } cbvh_wide_isa;
+cbvh_wide_isa cbvh_wide_float_isa(void);
+void cbvh_wide_float_limit_isa(cbvh_wide_isa max);
+const char *cbvh_wide_isa_name(cbvh_wide_isa isa);
+
 /* The CBVH decoded once (docs/traversal.md §12): per node pair, what
  * cbvh_trace_cbvh derives from it on every visit — both children's planes
  * u + r 2^e, u + s 2^e when every one is exact in binary64, their pointers
