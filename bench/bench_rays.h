@@ -84,9 +84,13 @@ static inline void bench_parse(int argc, char **argv, bench_args *a, const char 
             const char *w = argv[++i];
             if (strcmp(w, "base") && strcmp(w, "avx")) die("--wide-isa", "must be base or avx");
             cbvh_wide_float_limit_isa(strcmp(w, "avx") ? CBVH_WIDE_ISA_BASE : CBVH_WIDE_ISA_AVX);
+        } else if (!strcmp(argv[i], "--wide-box") && i + 1 < argc) { /* the wide float box lanes' precision */
+            const char *w = argv[++i];
+            if (strcmp(w, "f32") && strcmp(w, "f64")) die("--wide-box", "must be f32 or f64");
+            cbvh_wide_float_box32(!strcmp(w, "f32"));
         } else if (argv[i][0] == '-') {
             fprintf(stderr, "usage: " BENCH_NAME " [--rays R] [--seed S] [--reps K] [--embree-isa ISA] "
-                            "[--embree-robust] [--wide-isa base|avx] [SCENE...]\n");
+                            "[--embree-robust] [--wide-isa base|avx] [--wide-box f32|f64] [SCENE...]\n");
             exit(2);
         } else if (a->ns < 64) {
             a->specs[a->ns++] = argv[i];

@@ -15,7 +15,7 @@
  * closest hit and any hit, one core, as ratios to Embree.
  *
  * usage: bench_traverse [--rays R] [--seed S] [--reps K] [--embree-isa ISA] [--embree-robust]
- *                       [--wide-isa base|avx] [SCENE...]
+ *                       [--wide-isa base|avx] [--wide-box f32|f64] [SCENE...]
  *   SCENE as for `cbvh study` (mesh file or proc:NAME[:SIZE]); default: the
  *   bundled bunny.  R rays per kind (default 20000): camera rays (pinhole, a
  *   square image looking at the scene centre from outside its box) and random
@@ -29,7 +29,9 @@
  * x86-64 baseline (SSE2), so sse2 compares like with like; only the wide
  * float traversals (4- and 8-wide) also run an AVX build of their loop on
  * CPUs with AVX, which --wide-isa base turns off (the ISA in use is printed
- * first).  --embree-robust
+ * first); their box lanes are binary32 where the ray and planes allow
+ * (docs/traversal.md §16), binary64 everywhere with --wide-box f64.
+ * --embree-robust
  * builds Embree's scenes in its robust mode (RTC_SCENE_FLAG_ROBUST): ours
  * never miss (conservative boxes, exact triangles), Embree's default mode may. */
 #define _POSIX_C_SOURCE 200809L
@@ -118,7 +120,8 @@ int main(int argc, char **argv) {
     printf("(built without Embree: no baseline, absolute rays/s only)\n");
 #endif
     char err[512];
-    printf("# wide float traversals' box test: %s\n", cbvh_wide_isa_name(cbvh_wide_float_isa()));
+    printf("# wide float traversals' box test: %s, %s lanes\n", cbvh_wide_isa_name(cbvh_wide_float_isa()),
+           cbvh_wide_float_box32_on() ? "binary32 (where small enough)" : "binary64");
     printf("%-24s %7s %-12s %11s %11s %11s %11s %11s %11s %8s %8s %8s %8s %8s %8s %8s %8s %8s %7s %7s %7s %7s %7s "
            "%7s %7s %7s %11s %8s %7s %7s\n",
            "scene", "tris", "kind", "embree_r/s", "float_r/s", "bvh_r/s", "cbvh_r/s", "cbvhd_r/s", "flt4_r/s",

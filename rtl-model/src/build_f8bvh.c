@@ -98,7 +98,10 @@ int cbvh_f8bvh_build(const cbvh_bvh *b, const cbvh_tri *tris, uint32_t ntris, cb
         memset(out->nodes, 0, (size_t)nrec * sizeof *out->nodes); /* empty slots: zero planes, not valid */
     }
     out->nnodes = nrec;
-    /* Pass 2: the records (the same gather). */
+    /* Pass 2: the records (the same gather); small: every plane fits the
+     * binary32 box lanes (the root's too). */
+    int small = 1;
+    for (int a = 0; a < 3; a++) small &= cbvh_ref32_plane_ok(rt->lo[a]) & cbvh_ref32_plane_ok(rt->hi[a]);
     for (uint32_t i = 0; i < nrec; i++) {
         cbvh_f8bvh_node *r = &out->nodes[i];
         uint32_t ch[8];
@@ -108,6 +111,7 @@ int cbvh_f8bvh_build(const cbvh_bvh *b, const cbvh_tri *tris, uint32_t ntris, cb
             for (int a = 0; a < 3; a++) {
                 r->pl[(0 * 3 + a) * 8 + c] = n->lo[a];
                 r->pl[(1 * 3 + a) * 8 + c] = n->hi[a];
+                small &= cbvh_ref32_plane_ok(n->lo[a]) & cbvh_ref32_plane_ok(n->hi[a]);
             }
             r->child[c] = cbvh_bvh_is_leaf(n) ? CBVH_F8BVH_LEAF | n->first : rec[ch[c]];
             r->count[c] = (uint16_t)n->count;
@@ -116,6 +120,7 @@ int cbvh_f8bvh_build(const cbvh_bvh *b, const cbvh_tri *tris, uint32_t ntris, cb
     }
     free(rec);
     free(src);
+    out->small_planes = small;
     if (!tris || b->nprims == 0) return 0;
     for (uint32_t i = 0; i < b->nprims; i++)
         if (b->prims[i] >= ntris) return 0; /* left to the traversal's reads of tris */

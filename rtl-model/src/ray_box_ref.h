@@ -34,6 +34,15 @@
 #endif
 
 #define CBVH_REF_EPS 0x1p-50 /* > 2 * 3.0000001 * 2^-53 */
+/* The binary32 lanes (docs/traversal.md §16): magnitudes of origins, planes
+ * and directions (and their inverses) within 2^62, and the margins. */
+#define CBVH_REF32_LIMIT 0x1p62f
+#define CBVH_REF32_C0 (1.0f - 0x1p-20f)
+#define CBVH_REF32_C1 (1.0f + 0x1p-20f)
+#define CBVH_REF32_H 0x1p-140f
+
+/* A plane the binary32 lanes take (|p| <= 2^62; not NaN). */
+static inline int cbvh_ref32_plane_ok(float p) { return fabsf(p) <= CBVH_REF32_LIMIT; }
 
 /* A pair of boxes as 12 binary32: plane (lo = 0, hi = 1) of axis a of child c
  * at [CBVH_REF_AT(plane, a, c)]; four boxes as 24 at [CBVH_REF4_AT(...)]. */
@@ -46,6 +55,9 @@ typedef struct {
     int pn[3], pf[3]; /* CBVH_REF_AT(near / far plane, a, 0): the near plane is hi where d_a < 0 */
     int pn4[3], pf4[3]; /* the same for CBVH_REF4_AT */
     int general;      /* some d_a = +-0, or tmin < 0: cbvh_ref_box2_any, not cbvh_ref_box2 */
+    int small;        /* !general, |o_a| <= 2^62, 2^-62 <= |d_a| <= 2^62: the binary32 lanes may run
+                         (cbvh_ref_prepare32, docs/traversal.md §16; 0 until it runs) */
+    float o32[3], inv32[3], tmin32; /* o, RN32(1 / d), tmin in binary32 (where small) */
     _Alignas(16) double o2[3][2], inv2[3][2]; /* o, inv twice: an SSE2 register's two lanes */
 } cbvh_ref_ray;
 
@@ -66,6 +78,22 @@ static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
     }
     r->tmin = cbvh_float_of(ray->tmin);
     r->general = axis_par || r->tmin < 0;
+    r->small = 0;
+}
+
+/* The binary32 lanes' part of the preparation (docs/traversal.md §16), after
+ * cbvh_ref_prepare: r->small, and o, 1 / d (RN32) and tmin in binary32
+ * where small. */
+static inline void cbvh_ref_prepare32(const cbvh_ray *ray, cbvh_ref_ray *r) {
+    int small = !r->general;
+    for (int a = 0; a < 3; a++) {
+        float o = cbvh_float_of(ray->o[a]), d = cbvh_float_of(ray->d[a]);
+        small &= fabsf(o) <= CBVH_REF32_LIMIT && fabsf(d) >= 1.0f / CBVH_REF32_LIMIT && fabsf(d) <= CBVH_REF32_LIMIT;
+        r->o32[a] = o;
+        r->inv32[a] = small ? 1.0f / d : 0.0f;
+    }
+    r->tmin32 = cbvh_float_of(ray->tmin);
+    r->small = small;
 }
 
 /* Two boxes (lo <= hi, finite) against [tmin, cull] for a ray without zero
@@ -252,6 +280,73 @@ static inline int cbvh_ref_box8(const cbvh_ref_ray *r, const float box[48], doub
     return m;
 #else
     return cbvh_ref_boxw_c(r, box, 8, cull, t_lo);
+#endif
+}
+
+/* The binary32 lanes of docs/traversal.md §16, for a small ray (r->small)
+ * and planes of magnitude <= 2^62: per box and axis T = RN32(RN32(p - o) *
+ * inv32), N = max(tmin, T_near...), F = min(cull, T_far...), hit when
+ * N <= RN32(RN32(F * C1) + H), t_lo = RN32(RN32(N * C0) - H) widened.  w
+ * boxes (4 or 8), plane of axis a of box c at ((plane * 3) + a) * w + c; cull
+ * a binary32 value.  Returns the hit mask (bit c for box c). */
+static inline int cbvh_ref_boxw32_c(const cbvh_ref_ray *r, const float *box, int w, float cull, double *t_lo) {
+    int m = 0;
+    for (int c = 0; c < w; c++) {
+        float n = r->tmin32, f = cull;
+        for (int a = 0; a < 3; a++) {
+            float tn = (box[r->pn4[a] / 4 * w + c] - r->o32[a]) * r->inv32[a];
+            float tf = (box[r->pf4[a] / 4 * w + c] - r->o32[a]) * r->inv32[a];
+            n = tn > n ? tn : n;
+            f = tf < f ? tf : f;
+        }
+        float lo = n * CBVH_REF32_C0, hi = f * CBVH_REF32_C1;
+        t_lo[c] = (double)(lo - CBVH_REF32_H);
+        m |= (n <= hi + CBVH_REF32_H) << c;
+    }
+    return m;
+}
+
+#if CBVH_REF_SSE2
+/* Four boxes of a row of w in one SSE register (lanes c .. c + 3). */
+static inline int cbvh_ref_box32_sse(const cbvh_ref_ray *r, const float *box, int w, float cull, double *t_lo) {
+    __m128 n = _mm_set1_ps(r->tmin32), f = _mm_set1_ps(cull);
+    for (int a = 0; a < 3; a++) {
+        __m128 o = _mm_set1_ps(r->o32[a]), inv = _mm_set1_ps(r->inv32[a]);
+        n = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(box + r->pn4[a] / 4 * w), o), inv), n);
+        f = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(box + r->pf4[a] / 4 * w), o), inv), f);
+    }
+    __m128 h = _mm_set1_ps(CBVH_REF32_H), lo = _mm_sub_ps(_mm_mul_ps(n, _mm_set1_ps(CBVH_REF32_C0)), h);
+    _mm_storeu_pd(t_lo, _mm_cvtps_pd(lo));
+    _mm_storeu_pd(t_lo + 2, _mm_cvtps_pd(_mm_movehl_ps(lo, lo)));
+    return _mm_movemask_ps(_mm_cmple_ps(n, _mm_add_ps(_mm_mul_ps(f, _mm_set1_ps(CBVH_REF32_C1)), h)));
+}
+#endif
+
+static inline int cbvh_ref_box4_32(const cbvh_ref_ray *r, const float box[24], float cull, double t_lo[4]) {
+#if CBVH_REF_SSE2
+    return cbvh_ref_box32_sse(r, box, 4, cull, t_lo);
+#else
+    return cbvh_ref_boxw32_c(r, box, 4, cull, t_lo);
+#endif
+}
+
+static inline int cbvh_ref_box8_32(const cbvh_ref_ray *r, const float box[48], float cull, double t_lo[8]) {
+#if CBVH_REF_AVX
+    __m256 n = _mm256_set1_ps(r->tmin32), f = _mm256_set1_ps(cull);
+    for (int a = 0; a < 3; a++) {
+        __m256 o = _mm256_set1_ps(r->o32[a]), inv = _mm256_set1_ps(r->inv32[a]);
+        n = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(box + 2 * r->pn4[a]), o), inv), n);
+        f = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(box + 2 * r->pf4[a]), o), inv), f);
+    }
+    __m256 h = _mm256_set1_ps(CBVH_REF32_H), lo = _mm256_sub_ps(_mm256_mul_ps(n, _mm256_set1_ps(CBVH_REF32_C0)), h);
+    _mm256_storeu_pd(t_lo, _mm256_cvtps_pd(_mm256_castps256_ps128(lo)));
+    _mm256_storeu_pd(t_lo + 4, _mm256_cvtps_pd(_mm256_extractf128_ps(lo, 1)));
+    return _mm256_movemask_ps(
+        _mm256_cmp_ps(n, _mm256_add_ps(_mm256_mul_ps(f, _mm256_set1_ps(CBVH_REF32_C1)), h), _CMP_LE_OS));
+#elif CBVH_REF_SSE2
+    return cbvh_ref_box32_sse(r, box, 8, cull, t_lo) | cbvh_ref_box32_sse(r, box + 4, 8, cull, t_lo + 4) << 4;
+#else
+    return cbvh_ref_boxw32_c(r, box, 8, cull, t_lo);
 #endif
 }
 

@@ -157,17 +157,21 @@ static cbvh_f32 trunc_f32(double x) {
     return (cbvh_f32)((uint32_t)(e + 127) << 23 | (uint32_t)((b & 0xFFFFFFFFFFFFFull) >> 29));
 }
 
-/* The binary32 truncation of the exact quotient a/b, both given as binary64
- * approximations with relative error bounds ra, rb (|â - a| <= ra|â|, both
- * < 2^-20, â and b̂ of one strict sign): a/b lies in q̂[1 - r, 1 + r] with
- * r = 2(ra + rb) + 2^-48 (the 2^-48 covers the roundings of q̂ = â/b̂ and of
- * forming the two ends, each <= 2^-53 relative); when both ends truncate to
- * the same binary32 that is the exact result (truncation is monotone).
- * 0: undecided. */
-static cbvh_f32 quot_trunc(double a, double b, double ra, double rb) {
-    if (!(ra < 0x1p-20 && rb < 0x1p-20)) return 0;
-    double q = a / b, r = 2.0 * (ra + rb) + 0x1p-48;
-    cbvh_f32 lo = trunc_f32(q * (1.0 - r)), hi = trunc_f32(q * (1.0 + r));
+/* The binary32 truncation of the exact quotient a/b, given binary64
+ * approximations â (|â - a| <= ea) and b̂ (|b̂ - b| <= eb < 2^-20 |b̂|, b
+ * of b̂'s sign) through rb = RN(1 / b̂): with q = RN(â rb),
+ *     |a/b - q| <= (ea + |q| eb) |rb| (1 + 2^-19) + 2.0001 * 2^-53 |q|
+ * (|b| >= |b̂| (1 - 2^-20); q and |rb| are within two and one roundings of
+ * â/b̂ and 1/|b̂|).  W below exceeds that by more than the roundings of
+ * forming W and q -+ W (the factor 1.001 and 2^-48 |q| against three
+ * roundings of 2^-53 |q|), so a/b lies in [RN(q - W), RN(q + W)]; when both
+ * ends truncate to the same binary32 (trunc_f32: 0 unless positive and
+ * normal) that is the exact result (truncation is monotone).  0: undecided.
+ * One division (rb) serves every quotient with the same divisor. */
+static cbvh_f32 quot_trunc(double a, double ea, double rb, double eb) {
+    double q = a * rb, aq = fabs(q);
+    double W = 1.001 * ((ea + aq * eb) * fabs(rb)) + 0x1p-48 * aq;
+    cbvh_f32 lo = trunc_f32(q - W), hi = trunc_f32(q + W);
     return lo == hi ? lo : 0;
 }
 
@@ -272,14 +276,17 @@ static int filter(const cbvh_tri_ray *p, const cbvh_f32 v0[3], const cbvh_f32 v1
     if (!fill_hit) return 0;
     /* A certain hit: t = T / (det d_z), b1 = V / det, b2 = W / det, each the
      * truncation of a positive quotient.  det = U + V + W adds two roundings
-     * (its terms share a sign: <= 2.0001u sum |E|); det d_z one more. */
+     * (its terms share a sign: <= 2.0001u sum |E|); det d_z one more.  Two
+     * divisions: 1 / det for b1 and b2, 1 / (det d_z) for t. */
     double det = E[0] + E[1] + E[2], adet = fabs(det);
     double e_det = 1.001 * (eE[0] + eE[1] + eE[2] + 2.0001 * u * adet);
-    double den = det * dz, r_det = e_det / adet;
-    double r_den = (adz * e_det + 1.0001 * u * fabs(den)) / fabs(den);
-    cbvh_f32 t = quot_trunc(T, den, eT / fabs(T), r_den);
-    cbvh_f32 b1 = quot_trunc(E[1], det, eE[1] / fabs(E[1]), r_det);
-    cbvh_f32 b2 = quot_trunc(E[2], det, eE[2] / fabs(E[2]), r_det);
+    double den = det * dz, aden = fabs(den);
+    double e_den = adz * e_det + 1.0001 * u * aden;
+    if (!(e_det < 0x1p-20 * adet && e_den < 0x1p-20 * aden)) return 0;
+    double r_det = 1.0 / det, r_den = 1.0 / den;
+    cbvh_f32 t = quot_trunc(T, eT, r_den, e_den);
+    cbvh_f32 b1 = quot_trunc(E[1], eE[1], r_det, e_det);
+    cbvh_f32 b2 = quot_trunc(E[2], eE[2], r_det, e_det);
     if (!t || !b1 || !b2) return 0;
     memset(out, 0, sizeof *out);
     out->hit = 1;

@@ -15,6 +15,6 @@ _Static_assert(sizeof(cbvh_f8bvh_node) == WIDE_REC_BYTES(8) && offsetof(cbvh_f8b
 int cbvh_trace_f8bvh_float(const cbvh_f8bvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
                            cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     const wide_tree w = {(const unsigned char *)f->nodes, f->nnodes, f->root, f->root_count,
-                         f->root_box, f->leaf_tris, f->leaf_src, f->prims, f->nprims};
+                         f->root_box, f->leaf_tris, f->leaf_src, f->prims, f->nprims, f->small_planes};
     return wide_trace_isa(8, &w, tris, ray, mode, hit, st);
 }

@@ -70,6 +70,7 @@ int cbvh_fqbvh_build(const cbvh_qbvh *q, const cbvh_tri *tris, uint32_t ntris, c
         if (!out->nodes) return fail(out, rec, err, errlen, "out of memory", 0);
         memset(out->nodes, 0, (size_t)n * sizeof *out->nodes); /* empty slots: zero planes, not valid */
     }
+    int small = 1; /* every plane fits the binary32 box lanes (node 0 is the root) */
     for (uint32_t i = 0; i < q->nnodes; i++) {
         if (q->count[i] & CBVH_QBVH_LEAF) continue;
         cbvh_fqbvh_node *r = &out->nodes[rec[i]];
@@ -78,6 +79,7 @@ int cbvh_fqbvh_build(const cbvh_qbvh *q, const cbvh_tri *tris, uint32_t ntris, c
             for (int a = 0; a < 3; a++) {
                 r->pl[CBVH_REF4_AT(0, a, c)] = q->bmin[j][a];
                 r->pl[CBVH_REF4_AT(1, a, c)] = q->bmax[j][a];
+                small &= cbvh_ref32_plane_ok(q->bmin[j][a]) & cbvh_ref32_plane_ok(q->bmax[j][a]);
             }
             child_entry(q, j, rec, &r->child[c], &cnt);
             r->count[c] = (uint16_t)cnt;
@@ -89,7 +91,9 @@ int cbvh_fqbvh_build(const cbvh_qbvh *q, const cbvh_tri *tris, uint32_t ntris, c
         for (int a = 0; a < 3; a++) {
             out->root_box[CBVH_REF_AT(0, a, c)] = q->bmin[0][a];
             out->root_box[CBVH_REF_AT(1, a, c)] = q->bmax[0][a];
+            small &= cbvh_ref32_plane_ok(q->bmin[0][a]) & cbvh_ref32_plane_ok(q->bmax[0][a]);
         }
+    out->small_planes = small;
     free(rec);
     if (!tris || q->nprims == 0) return 0;
     for (uint32_t i = 0; i < q->nprims; i++)
@@ -112,6 +116,6 @@ _Static_assert(sizeof(cbvh_fqbvh_node) == WIDE_REC_BYTES(4) && offsetof(cbvh_fqb
 int cbvh_trace_qbvh_float(const cbvh_fqbvh *f, const cbvh_tri *tris, const cbvh_ray *ray, cbvh_trav_mode mode,
                           cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     const wide_tree w = {(const unsigned char *)f->nodes, f->nnodes, f->root, f->root_count,
-                         f->root_box, f->leaf_tris, f->leaf_src, f->q->prims, f->q->nprims};
+                         f->root_box, f->leaf_tris, f->leaf_src, f->q->prims, f->q->nprims, f->small_planes};
     return wide_trace_isa(4, &w, tris, ray, mode, hit, st);
 }

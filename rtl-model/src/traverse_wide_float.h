@@ -38,6 +38,7 @@ typedef struct {
     const cbvh_tri *leaf_src;
     const uint32_t *prims; /* the primitive array the leaves index */
     uint32_t nprims;
+    int small_planes; /* every plane's magnitude <= 2^62 (the binary32 lanes may run) */
 } wide_tree;
 
 /* Bits set in a mask of W bits (the x86-64 baseline has no popcount
@@ -50,10 +51,20 @@ static const uint8_t wide_low4[16] = {0, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 
 static const uint8_t wide_debruijn8[8] = {0, 1, 6, 2, 7, 5, 4, 3};
 
 static inline int wide_ones(int W, unsigned m) {
+#ifdef __POPCNT__
+    (void)W;
+    return __builtin_popcount(m);
+#else
     return W == 4 ? wide_ones4[m & 15u] : wide_ones4[m & 15u] + wide_ones4[m >> 4 & 15u];
+#endif
 }
 static inline int wide_low(int W, unsigned m) {
+#ifdef __POPCNT__
+    (void)W;
+    return __builtin_ctz(m);
+#else
     return W == 4 ? wide_low4[m & 15u] : wide_debruijn8[(m & (0u - m)) * 0x1Du >> 5 & 7u];
+#endif
 }
 
 /* The traversal (W = 4 or 8, a constant at each call): the nearest hit child
@@ -68,6 +79,11 @@ static inline int wide_trace(int W, const wide_tree *f, const cbvh_tri *tris, co
         return -1;
     cbvh_ref_ray r;
     cbvh_ref_prepare(ray, &r);
+    int small = 0; /* the binary32 lanes run (§16) */
+    if (f->small_planes && cbvh_wide_float_box32_on()) {
+        cbvh_ref_prepare32(ray, &r);
+        small = r.small;
+    }
     const cbvh_cbvh_dtri *lt = f->leaf_tris && f->leaf_src == tris ? f->leaf_tris : NULL;
     const unsigned char *recs = f->recs;
     plain_entry stack[CBVH_TRAV_STACK];
@@ -97,6 +113,9 @@ static inline int wide_trace(int W, const wide_tree *f, const cbvh_tri *tris, co
                 cbvh_ref_boxw_any(&r, pl, W, cull, hh, tl);
                 m = 0;
                 for (int c = 0; c < W; c++) m |= (unsigned)hh[c] << c;
+            } else if (small) {
+                m = (unsigned)(W == 4 ? cbvh_ref_box4_32(&r, pl, (float)cull, tl)
+                                      : cbvh_ref_box8_32(&r, pl, (float)cull, tl));
             } else {
                 m = (unsigned)(W == 4 ? cbvh_ref_box4(&r, pl, cull, tl) : cbvh_ref_box8(&r, pl, cull, tl));
             }

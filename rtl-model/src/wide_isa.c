@@ -1,14 +1,17 @@
 /* Which build of the wide float traversals' loop runs (cbvh_wide_float_isa,
  * docs/traversal.md §15): the AVX one where it was compiled in and the CPU
- * and OS have AVX (GCC's and Clang's __builtin_cpu_supports checks both:
- * CPUID and the OS saving the YMM registers), else the baseline. */
+ * and OS have AVX and POPCNT (every AVX CPU has it; GCC's and Clang's
+ * __builtin_cpu_supports checks CPUID and the OS saving the YMM registers),
+ * else the baseline; and
+ * whether its binary32 box lanes may run (§16). */
 #include "cbvh/traverse.h"
 
 static cbvh_wide_isa isa_limit = CBVH_WIDE_ISA_AVX;
 
 cbvh_wide_isa cbvh_wide_float_isa(void) {
 #ifdef CBVH_WIDE_AVX
-    if (isa_limit >= CBVH_WIDE_ISA_AVX && __builtin_cpu_supports("avx")) return CBVH_WIDE_ISA_AVX;
+    if (isa_limit >= CBVH_WIDE_ISA_AVX && __builtin_cpu_supports("avx") && __builtin_cpu_supports("popcnt"))
+        return CBVH_WIDE_ISA_AVX;
 #endif
     return CBVH_WIDE_ISA_BASE;
 }
@@ -16,3 +19,9 @@ cbvh_wide_isa cbvh_wide_float_isa(void) {
 void cbvh_wide_float_limit_isa(cbvh_wide_isa max) { isa_limit = max; }
 
 const char *cbvh_wide_isa_name(cbvh_wide_isa isa) { return isa == CBVH_WIDE_ISA_AVX ? "avx" : "base"; }
+
+static int box32 = 1;
+
+void cbvh_wide_float_box32(int on) { box32 = on != 0; }
+
+int cbvh_wide_float_box32_on(void) { return box32; }

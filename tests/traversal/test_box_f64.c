@@ -511,7 +511,7 @@ static float ref_coord(int wide) {
 }
 
 static void test_ref_lanes(void) {
-    long n = 0, ngeneral = 0, nhit = 0, n_margin = 0;
+    long n = 0, ngeneral = 0, nhit = 0, n_margin = 0, n32 = 0, n32_hit = 0;
     for (long i = 0; i < NBOX; i++) {
         int wide = (i & 3) == 0, M;
         cbvh_ray ray;
@@ -523,6 +523,7 @@ static void test_ref_lanes(void) {
             continue;
         cbvh_ref_ray r;
         cbvh_ref_prepare(&ray, &r);
+        cbvh_ref_prepare32(&ray, &r);
         float b4[24], b2[2][12], b8[48];
         for (int c = 0; c < 4; c++)
             for (int a = 0; a < 3; a++) {
@@ -564,6 +565,19 @@ static void test_ref_lanes(void) {
             for (int c = 0; c < 4; c++) g[c] = m >> c & 1;
             int m8 = cbvh_ref_box8(&r, b8, cull, u8);
             for (int c = 0; c < 8; c++) g8[c] = m8 >> c & 1;
+            int ok32 = r.small;
+            for (int k = 0; k < 48; k++) ok32 &= cbvh_ref32_plane_ok(b8[k]);
+            if (ok32) { /* the binary32 lanes (§16): SIMD == plain C, bit for bit */
+                float c32 = (float)cull;
+                double v4[4], w4[4], v8[8], w8[8];
+                if ((double)c32 != cull) c32 = bf(ray.tmax); /* cull is a binary32 value in the traversals */
+                int a4 = cbvh_ref_box4_32(&r, b4, c32, v4), c4 = cbvh_ref_boxw32_c(&r, b4, 4, c32, w4);
+                int a8 = cbvh_ref_box8_32(&r, b8, c32, v8), c8 = cbvh_ref_boxw32_c(&r, b8, 8, c32, w8);
+                n32++;
+                n32_hit += a8 != 0;
+                if ((a4 != c4 || memcmp(v4, w4, sizeof v4) || a8 != c8 || memcmp(v8, w8, sizeof v8)) && failures++ < 10)
+                    printf("FAIL ref lanes %ld: binary32 lanes %x/%x differ from the plain C %x/%x\n", i, a4, a8, c4, c8);
+            }
             int h2[2];
             double t2[2];
             for (int k = 0; k < 2; k++) { /* the two-box lanes too */
@@ -590,10 +604,50 @@ static void test_ref_lanes(void) {
     printf("plain float slab test: %ld rays x 4 boxes (%ld general, %ld culled just below an entry), %ld box hits; "
            "eight-, four- and two-box lanes (%s) equal the plain C\n",
            n, ngeneral, n_margin, nhit, CBVH_REF_AVX ? "AVX" : CBVH_REF_SSE2 ? "SSE2" : "plain C");
-    if (n < NBOX / 2 || ngeneral < n / 20 || n_margin < n / 200 || nhit < n / 4 || nhit > 3 * n) {
+    printf("binary32 lanes (%s): %ld rays x 8 boxes small enough for them, %ld with a hit; equal the plain C\n",
+           CBVH_REF_AVX ? "AVX" : CBVH_REF_SSE2 ? "SSE" : "plain C", n32, n32_hit);
+    if (n < NBOX / 2 || ngeneral < n / 20 || n_margin < n / 200 || nhit < n / 4 || nhit > 3 * n || n32 < n / 4 ||
+        n32_hit < n32 / 10) {
         printf("FAIL: plain float lane test inputs not varied enough\n");
         failures++;
     }
+}
+
+/* Which rays the binary32 lanes take (cbvh_ref_prepare32, docs/traversal.md
+ * §16): |o_a| <= 2^62 and 2^-62 <= |d_a| <= 2^62 on every axis, tmin >= 0,
+ * no zero d_a; each limit and the binary32 just beyond it, either sign. */
+static void test_small_rays(void) {
+    static const struct {
+        int field; /* 0 o, 1 d, 2 tmin */
+        cbvh_f32 v;
+        int small;
+    } cases[] = {{0, 0x5E800000u, 1},  {0, 0x5E800001u, 0}, {0, 0xDE800000u, 1}, {0, 0xDE800001u, 0},
+                 {0, 0, 1},            {0, 0x00000001u, 1}, {1, 0x5E800000u, 1}, {1, 0x5E800001u, 0},
+                 {1, 0xA0800000u, 1},  {1, 0xA07FFFFFu, 0}, {1, 0x20800000u, 1}, {1, 0, 0},
+                 {1, CBVH_F32_SIGN, 0}, {2, 0xBF800000u, 0}, {2, CBVH_F32_SIGN, 1}, {2, 0x7F7FFFFFu, 1}};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
+        for (int a = 0; a < 3; a++) {
+            cbvh_ray ray = {{0x3F800000u, 0xBF800000u, 0x40000000u}, {0x3F000000u, 0x3F800000u, 0xBF800000u}, 0,
+                            CBVH_F32_POS_INF};
+            if (cases[k].field == 0) ray.o[a] = cases[k].v;
+            else if (cases[k].field == 1) ray.d[a] = cases[k].v;
+            else ray.tmin = cases[k].v;
+            cbvh_ref_ray r;
+            cbvh_ref_prepare(&ray, &r);
+            if (r.small) {
+                printf("FAIL small rays: r.small set before cbvh_ref_prepare32\n");
+                failures++;
+            }
+            cbvh_ref_prepare32(&ray, &r);
+            int inv_ok = 1;
+            for (int b = 0; b < 3 && r.small; b++) inv_ok &= r.inv32[b] == 1.0f / bf(ray.d[b]);
+            if (r.small != cases[k].small || !inv_ok) {
+                printf("FAIL small rays: case %zu axis %d (%08X): small %d, want %d\n", k, a, cases[k].v, r.small,
+                       cases[k].small);
+                failures++;
+            }
+        }
+    printf("binary32 lanes' ray limits: %zu cases x 3 axes checked\n", sizeof cases / sizeof cases[0]);
 }
 
 int main(void) {
@@ -603,6 +657,7 @@ int main(void) {
         return 77;
     }
 #endif
+    test_small_rays();
     test_ref_lanes();
     test_float_boxes();
     test_filter_margin();

@@ -9,7 +9,9 @@
  * Plus NaN/Inf/zero-direction rejects and the float-plane variant, and the
  * plain floating-point traversal's binary64 box test (ray_box_ref.h,
  * docs/traversal.md §11) on every input whose planes are binary32: never a
- * false miss, t_lo <= the exact near t. */
+ * false miss, t_lo <= the exact near t; the same for its binary32 lanes
+ * (§16) wherever the ray and planes are small enough for them, plus rays
+ * whose plane distances underflow binary32 (subnormal and zero t). */
 #include <gmp.h>
 #include <math.h>
 #include <stdio.h>
@@ -99,6 +101,7 @@ static void q_step(mpq_t out, cbvh_f32 x, int M, int up) {
 
 static long n_hit, n_exact_hit, failures;
 static long n_ref_checked, n_ref_exact_hit, n_ref_hit;
+static long n_ref32_checked, n_ref32_exact_hit, n_ref32_tiny;
 
 /* Plane u + c 2^e as a binary32 when it is one exactly (1), else 0. */
 static int plane_f32(const cbvh_grid_axis *g, uint32_t c, cbvh_f32 *out) {
@@ -131,6 +134,34 @@ static void ref_box(const cbvh_ray *ray, const float box[12], int general, int h
     double cull = cbvh_float_of(ray->tmax);
     if (general) cbvh_ref_box2_any(&rr, box, cull, hit, t_lo);
     else cbvh_ref_box2_for(&rr, box, cull, hit, t_lo);
+}
+
+/* The binary32 lanes (cbvh_ref_boxw32_c, docs/traversal.md §16) on the same
+ * two boxes when the ray and planes are small enough, checked against the
+ * exact result of box 0 (hit, exact near tn): never a false miss, t_lo <=
+ * tn.  Box 1 must be a superset of box 0 (or the same). */
+static void check_ref32(const cbvh_ray *ray, const float box[12], int hit, const mpq_t tn) {
+    cbvh_ref_ray rr;
+    cbvh_ref_prepare(ray, &rr);
+    cbvh_ref_prepare32(ray, &rr);
+    int ok = rr.small;
+    for (int k = 0; k < 12; k++) ok &= cbvh_ref32_plane_ok(box[k]);
+    if (!ok) return;
+    double tl[2];
+    int m = cbvh_ref_boxw32_c(&rr, box, 2, bf(ray->tmax), tl);
+    n_ref32_checked++;
+    n_ref32_exact_hit += hit;
+    cbvh_grid_axis none[3] = {{0, 0, 0, 1}, {0, 0, 0, 1}, {0, 0, 0, 1}};
+    if (hit && (m & 3) != 3) fail("binary32 lanes: false miss", ray, 24, none);
+    if (hit) {
+        mpq_t t;
+        mpq_init(t);
+        mpq_set_d(t, tl[0]);
+        if (mpq_cmp(t, tn) > 0) fail("binary32 lanes: t_lo above exact near", ray, 24, none);
+        mpq_set_d(t, 0x1p-126);
+        n_ref32_tiny += mpq_cmp(tn, t) < 0;
+        mpq_clear(t);
+    }
 }
 
 /* The exact slab test on rational planes lo[a] <= hi[a]: 1 on a hit, with
@@ -215,6 +246,7 @@ static void check(const cbvh_ray *ray, int M, const cbvh_grid_axis g[3]) {
             mpq_set_d(t, tl[0]);
             if (mpq_cmp(t, tn) > 0) fail("plain float box: t_lo above exact near", ray, M, g);
         }
+        check_ref32(ray, box, hit, tn);
     }
     n_hit += res.hit;
     if (hit && !res.hit) fail("false miss", ray, M, g);
@@ -357,6 +389,7 @@ static void check_ref_float(const cbvh_ray *ray, const cbvh_f32 lo[3], const cbv
         mpq_set_d(n, gl[0]);
         if (mpq_cmp(n, tn) > 0) fail("plain float box: general t_lo above exact near", ray, 24, none);
     }
+    check_ref32(ray, box, hit, tn);
     for (int a = 0; a < 3; a++) mpq_clears(ql[a], qh[a], NULL);
     mpq_clears(tn, tf, n, NULL);
 }
@@ -399,6 +432,48 @@ static void random_float_box(void) {
     cbvh_f32 lo1 = below(2) ? lo[0] : rfloat();
     if (cbvh_f32_key(lo1) > cbvh_f32_key(lo[0])) lo1 = lo[0];
     check_ref_float(&r, lo, hi, lo1);
+}
+
+/* Where the binary32 lanes underflow: an origin and planes a few multiples
+ * of a small spacing apart (down to 2^-149), directions up to 2^62 in
+ * magnitude, so plane distances are subnormal or round to zero; tmax
+ * sometimes a binary32 near the exact far t (the far margin decides). */
+static void random_tiny_box(void) {
+    cbvh_f32 lo[3], hi[3];
+    cbvh_ray r;
+    int e = -149 + (int)below(40); /* the spacing 2^e */
+    for (int a = 0; a < 3; a++) {
+        float base = ldexpf((float)((int)below(2001) - 1000), e);
+        float x = base + ldexpf((float)((int)below(9) - 4), e), y = base + ldexpf((float)((int)below(9) - 4), e);
+        lo[a] = fb(x < y ? x : y);
+        hi[a] = fb(x < y ? y : x);
+        r.o[a] = below(4) ? fb(base + ldexpf((float)((int)below(13) - 6), e)) : (below(2) ? lo[a] : hi[a]);
+        float d = ldexpf(1.0f + (float)below(1u << 20) * 0x1p-20f, (int)below(125) - 62);
+        r.d[a] = fb(below(2) ? -d : d);
+    }
+    r.tmin = below(4) ? 0 : fb(ldexpf(1.0f, -149 + (int)below(30)));
+    r.tmax = CBVH_F32_POS_INF;
+    if (below(2)) { /* tmax at or just around the exact far t of the box */
+        mpq_t ql[3], qh[3], tn, tf;
+        for (int a = 0; a < 3; a++) {
+            mpq_inits(ql[a], qh[a], NULL);
+            q_f32(ql[a], lo[a]);
+            q_f32(qh[a], hi[a]);
+        }
+        mpq_inits(tn, tf, NULL);
+        int far_inf, na, fa;
+        exact_slab(&r, ql, qh, tn, tf, &far_inf, &na, &fa);
+        if (!far_inf && mpq_sgn(tf) > 0) {
+            cbvh_f32 t = fb((float)mpq_get_d(tf)); /* the far t truncated, then a few ulps either way */
+            int64_t k = (int64_t)t + (int64_t)below(5) - 2;
+            if (k < 0) k = 0;
+            r.tmax = (cbvh_f32)k;
+            if (cbvh_f32_key(r.tmax) < cbvh_f32_key(r.tmin)) r.tmin = r.tmax;
+        }
+        for (int a = 0; a < 3; a++) mpq_clears(ql[a], qh[a], NULL);
+        mpq_clears(tn, tf, NULL);
+    }
+    check_ref_float(&r, lo, hi, lo[0]);
 }
 
 static void rejects(void) {
@@ -486,8 +561,16 @@ int main(void) {
            "tightness checked %ld, failures %ld\n",
            total, CBVH_MANT_MIN, CBVH_MANT_MAX, n_exact_hit, n_hit, n_hit - n_exact_hit, n_tight_checked, failures);
     for (long i = 0; i < N_CASES / 2; i++) random_float_box();
+    for (long i = 0; i < N_CASES / 4; i++) random_tiny_box();
     printf("plain float box test: %ld inputs with binary32 planes, exact hits %ld, its hits %ld\n", n_ref_checked,
            n_ref_exact_hit, n_ref_hit);
+    printf("its binary32 lanes: %ld inputs small enough for them, exact hits %ld (%ld entering below 2^-126)\n",
+           n_ref32_checked, n_ref32_exact_hit, n_ref32_tiny);
+    if (n_ref32_checked < N_CASES / 4 || n_ref32_exact_hit < n_ref32_checked / 20 || n_ref32_tiny < N_CASES / 100) {
+        fprintf(stderr, "FAIL: too few binary32 lane checks (%ld, %ld exact hits, %ld tiny)\n", n_ref32_checked,
+                n_ref32_exact_hit, n_ref32_tiny);
+        return 1;
+    }
     if (n_ref_checked < N_CASES / 2 || n_ref_exact_hit < n_ref_checked / 20) {
         fprintf(stderr, "FAIL: too few plain float box checks (%ld, %ld exact hits)\n", n_ref_checked,
                 n_ref_exact_hit);

@@ -150,13 +150,21 @@ static long decoded_vs_unit(const cbvh_cbvh_decoded *d, long *exact, long *f32) 
     return bad;
 }
 
-static void run_scene(const char *spec) {
+/* One scene; scale_exp != 0: every vertex times 2^scale_exp (exact), and
+ * the scene named huge (its planes beyond the binary32 lanes' 2^62). */
+static void run_scene(const char *spec, int scale_exp) {
     cbvh_scene s;
     char err[256];
     if (cbvh_scene_open(spec, &s, err, sizeof err)) {
         fprintf(stderr, "FAIL %s: %s\n", spec, err);
         failures++;
         return;
+    }
+    if (scale_exp) {
+        for (uint32_t t = 0; t < s.ntris; t++)
+            for (int v = 0; v < 3; v++)
+                for (int a = 0; a < 3; a++) s.tris[t].v[v][a] = ldexpf(s.tris[t].v[v][a], scale_exp);
+        spec = "bunny-small.obj x 2^64 (huge)";
     }
     cbvh_bvh b;
     if (cbvh_build_sah(&s, 0, 0, &b, err, sizeof err)) {
@@ -193,10 +201,11 @@ static void run_scene(const char *spec) {
     }
     cbvh_trav_stats ws[2] = {{0}, {0}};
     long hits = 0, plain_mismatch = 0, wide_mismatch[2] = {0, 0}, isa_mismatch[2] = {0, 0}, isa_rays[2] = {0, 0};
+    long lane_mismatch[2] = {0, 0}, lane_box_diff[2] = {0, 0};
     const cbvh_wide_isa isa = cbvh_wide_float_isa();
 #ifdef CBVH_WIDE_AVX /* the library has the AVX loop: a CPU with AVX runs it */
-    if (__builtin_cpu_supports("avx") && isa != CBVH_WIDE_ISA_AVX) {
-        fprintf(stderr, "FAIL: this CPU has AVX, but the wide float traversals run the %s loop\n",
+    if (__builtin_cpu_supports("avx") && __builtin_cpu_supports("popcnt") && isa != CBVH_WIDE_ISA_AVX) {
+        fprintf(stderr, "FAIL: this CPU has AVX and POPCNT, but the wide float traversals run the %s loop\n",
                 cbvh_wide_isa_name(isa));
         failures++;
     }
@@ -249,6 +258,21 @@ static void run_scene(const char *spec) {
                     }
                     isa_rays[W]++;
                 }
+                /* the binary64 lanes (§16's fallback) on every box: the same hits */
+                if (!k) {
+                    cbvh_trav_hit dh, da;
+                    cbvh_trav_stats dc1 = {0}, da1 = {0};
+                    cbvh_wide_float_box32(0);
+                    int rc = aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_CLOSEST, &dh, &dc1) ||
+                             aw_trace(&aw[W][k], s.tris, &rays[i], CBVH_TRAV_ANY, &da, &da1);
+                    cbvh_wide_float_box32(1);
+                    if (rc || memcmp(&dh, &qh, sizeof dh) || memcmp(&da, &qa, sizeof da)) {
+                        if (lane_mismatch[W]++ < 3)
+                            fprintf(stderr, "FAIL %s ray %d: %s plain float, binary64 lanes != binary32 lanes\n",
+                                    spec, i, wide_name[W]);
+                    }
+                    lane_box_diff[W] += (long)(qc1.box_tests - dc1.box_tests);
+                }
             }
         if (i < BRUTE) {
             cbvh_trav_hit bf = brute(&s, &rays[i]);
@@ -275,7 +299,15 @@ static void run_scene(const char *spec) {
                spec, s.ntris, wide_name[W], (double)q->nodes / RAYS, (double)q->box_tests / RAYS,
                (double)q->tri_tests / RAYS, (double)q->bytes / RAYS, wide_mismatch[W], cbvh_wide_isa_name(isa),
                isa_rays[W] / 2, isa_mismatch[W]);
-        failures += wide_mismatch[W] + isa_mismatch[W];
+        printf("%-22s %6u tris: %s plain float: binary32 lanes %s, hits as the binary64 lanes' on every ray "
+               "(%ld differ), box tests %+ld over them\n",
+               spec, s.ntris, wide_name[W], have_w[W] && aw_small(&aw[W][0]) ? "used" : "not used (planes too large)",
+               lane_mismatch[W], lane_box_diff[W]);
+        failures += wide_mismatch[W] + isa_mismatch[W] + lane_mismatch[W];
+        if (have_w[W] && !aw_small(&aw[W][0]) == !strstr(spec, "huge")) {
+            fprintf(stderr, "FAIL %s: %s small_planes = %d\n", spec, wide_name[W], aw_small(&aw[W][0]));
+            failures++;
+        }
         if (have_w[W] && (q->nodes >= fewer->nodes || q->nodes < ps.nodes / (W ? 8 : 4) ||
                           q->bytes != q->lines * CBVH_LINE_BYTES || q->tri_tests > ps.tri_tests + ps.tri_tests / 100 + 10)) {
             fprintf(stderr, "FAIL %s: %s counters: %llu nodes (%s %llu), %llu tri tests (binary %llu)\n", spec,
@@ -908,9 +940,10 @@ int main(void) {
     decoded_malformed();
     decoded_leaves();
     memory_map();
-    run_scene(CBVH_SCENES_DIR "/bunny-small.obj");
-    run_scene("proc:far:8");
-    run_scene("proc:cloth:24");
+    run_scene(CBVH_SCENES_DIR "/bunny-small.obj", 0);
+    run_scene("proc:far:8", 0);
+    run_scene("proc:cloth:24", 0);
+    run_scene(CBVH_SCENES_DIR "/bunny-small.obj", 64);
     if (failures) fprintf(stderr, "%ld failures\n", failures);
     return failures ? 1 : 0;
 }

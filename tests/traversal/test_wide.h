@@ -47,6 +47,7 @@ static inline const cbvh_cbvh_dtri *aw_leaf_tris(const any_wide *a) {
     return a->w8 ? a->f8.leaf_tris : a->f4.leaf_tris;
 }
 static inline const cbvh_tri *aw_leaf_src(const any_wide *a) { return a->w8 ? a->f8.leaf_src : a->f4.leaf_src; }
+static inline int aw_small(const any_wide *a) { return a->w8 ? a->f8.small_planes : a->f4.small_planes; }
 static inline uint32_t aw_valid(const any_wide *a, uint32_t i) {
     return a->w8 ? a->f8.nodes[i].valid : a->f4.nodes[i].valid;
 }

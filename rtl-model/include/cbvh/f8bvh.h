@@ -34,6 +34,7 @@ typedef struct {
     uint32_t nprims;
     const cbvh_tri *leaf_src;  /* the triangles copied into leaf_tris, or NULL */
     cbvh_cbvh_dtri *leaf_tris; /* nprims records in prims order: a leaf's triangles side by side */
+    int small_planes;          /* every plane's magnitude <= 2^62: the binary32 box lanes may run (§16) */
 } cbvh_f8bvh;
 
 /* Collapse b (rtl-model/src/build_f8bvh.c): each inner record takes up to 8

@@ -103,8 +103,9 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
  * (docs/traversal.md §13): one 128-byte record per inner node with its
  * children's four boxes as [lower, upper][axis][child] binary32, tested by
  * the conservative binary64 slab test of the plain float traversal
- * (cbvh_trace_bvh_float; four lanes, never a false miss), triangles by the
- * ray-triangle unit.  Same hit rules as cbvh_trace_bvh, so the closest hit
+ * (cbvh_trace_bvh_float; four lanes, never a false miss) or its binary32
+ * lanes where the ray and planes allow (docs/traversal.md §16), triangles by
+ * the ray-triangle unit.  Same hit rules as cbvh_trace_bvh, so the closest hit
  * equals it bit for bit (ties go to the lowest primitive ID whatever the
  * order) and the any-hit flag too. */
 #define CBVH_FQBVH_LEAF 0x80000000u /* child entry of a leaf: | its first index into prims */
@@ -124,6 +125,7 @@ typedef struct {
     float root_box[12];        /* the root's box as child 0 and 1 of a pair (cbvh_ref_box2) */
     const cbvh_tri *leaf_src;  /* the triangles copied into leaf_tris, or NULL */
     cbvh_cbvh_dtri *leaf_tris; /* q->nprims records in prims order: a leaf's triangles side by side */
+    int small_planes;          /* every plane's magnitude <= 2^62: the binary32 box lanes may run (§16) */
 } cbvh_fqbvh;
 
 /* 0, or -1 with a one-line reason (out of memory, a leaf of more than 65535

@@ -103,6 +103,15 @@ cbvh_wide_isa cbvh_wide_float_isa(void);
 void cbvh_wide_float_limit_isa(cbvh_wide_isa max);
 const char *cbvh_wide_isa_name(cbvh_wide_isa isa);
 
+/* The precision of the wide float traversals' box lanes (docs/traversal.md
+ * §16): binary32 (the default) where the ray and the tree's planes are
+ * small enough for its error bound (magnitudes within 2^62), binary64
+ * otherwise; cbvh_wide_float_box32(0) keeps every box on binary64 (tests
+ * and benchmarks compare the two; set before tracing).  Either way never a
+ * false miss, so the hits are the same; box-test counts may differ. */
+void cbvh_wide_float_box32(int on);
+int cbvh_wide_float_box32_on(void);
+
 /* The CBVH decoded once (docs/traversal.md §12): per node pair, what
  * cbvh_trace_cbvh derives from it on every visit — both children's planes
  * u + r 2^e, u + s 2^e when every one is exact in binary64, their pointers
