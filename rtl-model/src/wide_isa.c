@@ -2,8 +2,7 @@
  * docs/traversal.md §15): the AVX one where it was compiled in and the CPU
  * and OS have AVX and POPCNT (every AVX CPU has it; GCC's and Clang's
  * __builtin_cpu_supports checks CPUID and the OS saving the YMM registers),
- * else the baseline; and
- * whether its binary32 box lanes may run (§16). */
+ * else the baseline.  And whether its binary32 box lanes may run (§16). */
 #include "cbvh/traverse.h"
 
 static cbvh_wide_isa isa_limit = CBVH_WIDE_ISA_AVX;
