@@ -6,6 +6,7 @@
 
 #include "cbvh/traverse.h"
 #include "ray_prep.h"
+#include "tri_filter_avx.h"
 
 /* Memory image used for the byte counters: node pairs from address 0, then
  * the primitive-ID array, then the triangles (36 bytes each), each region
@@ -81,7 +82,15 @@ static inline void trav_triangle_v(trav_state *ts, uint32_t id, const cbvh_f32 v
     trav_fetch(ts, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
     ts->s.tri_tests++;
     cbvh_tri_result r;
+#if CBVH_REF_AVX
+    /* the wide AVX loop (§15): the unit's filter in lanes decides nearly every
+     * triangle without the unit's call; the unit takes the rest */
+    int f = cbvh_tri_filter_avx(&ts->tprep, v[0], v[1], v[2], &r, NULL);
+    if (f == 1 || (f == 0 && (cbvh_ray_triangle_prepared(&ts->tprep, ts->ray, v[0], v[1], v[2], &r) || !r.hit)))
+        return;
+#else
     if (cbvh_ray_triangle_prepared(&ts->tprep, ts->ray, v[0], v[1], v[2], &r) || !r.hit) return;
+#endif
     int64_t k = cbvh_f32_key(r.t);
     if (k < cbvh_f32_key(ts->ray->tmin) || k > cbvh_f32_key(ts->ray->tmax)) return;
     if ((ts->mode & CBVH_TRAV_FRONT_ONLY) && cbvh_tri_facing(ts->ray->d, v[0], v[1], v[2]) <= 0) return;

@@ -5,6 +5,8 @@
  *     (fast path + fallback) equals the exact path always;
  *   - ray-triangle: whenever the binary64 miss filter claims a miss, the
  *     exact path misses; the public unit equals the exact path always;
+ *     built with -mavx (traversal_fast_path.avx), the wide loop's filter in
+ *     four lanes equals the scalar filter on every case;
  *   - and the fast paths actually decide most random cases (so the speed-up
  *     is real and the comparison above is not vacuous).
  * Inputs: random values over wide exponent ranges plus the hard cases -
@@ -12,11 +14,13 @@
  * directions, exact quotients that land on the M-bit grid, -Inf context
  * bounds, far-from-origin boxes, rays through triangle vertices and edges,
  * rays in the triangle's plane, degenerate triangles. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../../rtl-model/src/ray_prep.h"
+#include "../../rtl-model/src/tri_filter_avx.h"
 #include "cbvh/traversal_units.h"
 #include "test_util.h"
 
@@ -219,6 +223,86 @@ static int exact_edge_ray(cbvh_ray *ray, cbvh_f32 v[3][3]) {
 
 static long typ_tri_miss, typ_tri_decided, typ_tri_hit, typ_tri_hit_decided, tri_hit_decided;
 
+#if CBVH_REF_AVX
+/* The scalar filter's edge functions and bounds E, eE, Z, eZ of §9, in
+ * ray_triangle.c's order of operations: the reference for the lanes' values. */
+static int filter_bounds_ref(const cbvh_tri_ray *p, const cbvh_f32 v[3][3], double ref[4][3]) {
+    const double u = 0x1p-53;
+    double px[3], py[3], pz[3], X[3], Y[3], eX[3], eY[3], Pm = 0;
+    for (int i = 0; i < 3; i++) {
+        px[i] = (double)cbvh_float_of(v[i][p->kx]) - p->ox;
+        py[i] = (double)cbvh_float_of(v[i][p->ky]) - p->oy;
+        pz[i] = (double)cbvh_float_of(v[i][p->kz]) - p->oz;
+        X[i] = px[i] * p->dz - pz[i] * p->dx;
+        Y[i] = py[i] * p->dz - pz[i] * p->dy;
+        double apz = fabs(pz[i]);
+        Pm = fmax(Pm, fmax(fabs(px[i]), fmax(fabs(py[i]), apz)));
+        eX[i] = 4.0 * u * (fabs(px[i]) * fabs(p->dz) + apz * fabs(p->dx));
+        eY[i] = 4.0 * u * (fabs(py[i]) * fabs(p->dz) + apz * fabs(p->dy));
+        ref[2][i] = pz[i];
+        ref[3][i] = 1.0001 * u * apz;
+    }
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        double a = X[k] * Y[j], c = Y[k] * X[j];
+        ref[0][i] = a - c;
+        ref[1][i] = 1.001 * (fabs(X[k]) * eY[j] + fabs(Y[j]) * eX[k] + eX[k] * eY[j] + fabs(Y[k]) * eX[j] +
+                             fabs(X[j]) * eY[k] + eX[j] * eY[k] + 2.0001 * u * (fabs(a) + fabs(c)));
+    }
+    double s = Pm * fabs(p->dz), B = 0x1p-46 * s * s; /* 1: the quick miss fires */
+    int pos = 0, neg = 0;
+    for (int i = 0; i < 3; i++) pos |= ref[0][i] > B, neg |= ref[0][i] < -B;
+    return pos & neg;
+}
+
+/* The wide AVX loop's filter in lanes (tri_filter_avx.h, §15) on every
+ * triangle case: its result is the scalar filter's (1 miss, 2 hit with the
+ * same outputs, 0 undecided; cbvh_ray_triangle_filter_miss / _hit run the
+ * scalar one), a miss or hit is the exact path's, and with one coordinate
+ * made infinite or NaN it gives 0 (the unit does not filter such triangles). */
+static long lanes_total, lanes_miss, lanes_hit, typ_lanes_miss, lanes_bounds;
+static void check_filter_lanes(const cbvh_ray *ray, const cbvh_f32 v[3][3], uint32_t se, const cbvh_tri_result *re,
+                               int typ) {
+    cbvh_tri_ray p;
+    cbvh_tri_ray_prepare(ray, &p);
+    if (!p.ok) return;
+    cbvh_tri_result rl, rh;
+    memset(&rl, 0xA5, sizeof rl);
+    double lanes[4][4], ref[4][3];
+    lanes[0][0] = NAN;
+    int fl = cbvh_tri_filter_avx(&p, v[0], v[1], v[2], &rl, lanes);
+    int quick = filter_bounds_ref(&p, v, ref);
+    if (quick != isnan(lanes[0][0]) && failures++ < 10)
+        fprintf(stderr, "FAIL tri filter in lanes: quick miss %d, scalar %d\n", isnan(lanes[0][0]), quick);
+    if (!isnan(lanes[0][0])) { /* formed (past the quick miss): the same values bit for bit */
+        lanes_bounds++;
+        for (int q = 0; q < 4; q++)
+            for (int i = 0; i < 3; i++)
+                if (memcmp(&lanes[q][i], &ref[q][i], sizeof(double)) && failures++ < 10)
+                    fprintf(stderr, "FAIL tri filter in lanes: value %d of lane %d %a, scalar %a\n", q, i,
+                            lanes[q][i], ref[q][i]);
+    }
+    int fm = cbvh_ray_triangle_filter_miss(ray, v[0], v[1], v[2]);
+    int fh = cbvh_ray_triangle_filter_hit(ray, v[0], v[1], v[2], &rh);
+    lanes_total++;
+    lanes_miss += fl == 1;
+    lanes_hit += fl == 2;
+    typ_lanes_miss += typ && fl == 1;
+    if (fl != (fm ? 1 : fh ? 2 : 0) && failures++ < 10)
+        fprintf(stderr, "FAIL tri filter in lanes: %d, scalar filter miss %d hit %d\n", fl, fm, fh);
+    if (fl == 2 && (memcmp(&rl, &rh, sizeof rl) || memcmp(&rl, re, sizeof rl) || se != 0) && failures++ < 10)
+        fprintf(stderr, "FAIL tri filter in lanes: hit outputs differ from the scalar filter's or the exact path's\n");
+    if (fl == 1 && (se != 0 || re->hit) && failures++ < 10)
+        fprintf(stderr, "FAIL tri filter in lanes claims a miss: exact status %X hit %d\n", se, re->hit);
+    static const cbvh_f32 special[4] = {CBVH_F32_POS_INF, CBVH_F32_NEG_INF, 0x7FC00000u, 0xFFC00001u};
+    cbvh_f32 w[3][3];
+    memcpy(w, v, sizeof w);
+    w[below(3)][below(3)] = special[below(4)];
+    if (cbvh_tri_filter_avx(&p, w[0], w[1], w[2], &rl, NULL) && failures++ < 10)
+        fprintf(stderr, "FAIL tri filter in lanes decides a triangle with a non-finite vertex\n");
+}
+#endif
+
 static void tri_cases(long *decided, long *total, long *exact_hits) {
     for (long i = 0; i < NTRI; i++) {
         typical = (i & 3) == 0;
@@ -294,6 +378,9 @@ static void tri_cases(long *decided, long *total, long *exact_hits) {
         if (fm && fh) {
             if (failures++ < 10) fprintf(stderr, "FAIL tri %ld: filter claims both a hit and a miss\n", i);
         }
+#if CBVH_REF_AVX
+        check_filter_lanes(&ray, (const cbvh_f32(*)[3])v, se, &re, typical);
+#endif
         if (fm) {
             (*decided)++;
             if (se != 0 || re.hit) {
@@ -344,6 +431,9 @@ static void tri_hit_cases(long *hits, long *decided, long *on_grid) {
         }
         *hits += re.hit;
         if (re.hit && (re.t & CBVH_F32_FRAC) == 0) (*on_grid)++;
+#if CBVH_REF_AVX
+        check_filter_lanes(&ray, (const cbvh_f32(*)[3])v, se, &re, 0);
+#endif
         if (cbvh_ray_triangle_filter_hit(&ray, v[0], v[1], v[2], &rh)) {
             (*decided)++;
             if (se != 0 || memcmp(&re, &rh, sizeof re)) {
@@ -392,6 +482,12 @@ static void tri_axes(void) {
 }
 
 int main(void) {
+#if CBVH_REF_AVX && defined(__GNUC__)
+    if (!__builtin_cpu_supports("avx")) {
+        printf("skipped: built with AVX lanes, and this CPU has no AVX\n");
+        return 77;
+    }
+#endif
     long bd = 0, bt = 0, fd = 0, ft = 0, td = 0, tt = 0, th = 0;
     tri_axes();
     box_cases(&bd, &bt);
@@ -414,6 +510,16 @@ int main(void) {
     printf("scene-like inputs: box fast path decided %.3f%% of %ld, triangle filter proved %.3f%% of %ld misses\n",
            100.0 * (double)typ_decided / (double)typ_total, typ_total,
            100.0 * (double)typ_tri_decided / (double)typ_tri_miss, typ_tri_miss);
+#if CBVH_REF_AVX
+    printf("ray_triangle filter in four lanes: %ld inputs, %ld misses (%ld of %ld scene-like misses), %ld hits "
+           "decided, each compared with the scalar filter; bounds of %ld compared bit for bit\n",
+           lanes_total, lanes_miss, typ_lanes_miss, typ_tri_miss, lanes_hit, lanes_bounds);
+    if (lanes_total < 2 * NTRI * 99 / 100 || typ_lanes_miss < typ_tri_miss * 9 / 10 || lanes_hit < NTRI / 2 ||
+        lanes_bounds < NTRI) {
+        fprintf(stderr, "FAIL: the filter in lanes decides too few cases\n");
+        failures++;
+    }
+#endif
     /* the fast paths must carry the bulk of the work, or the speed-up is fake */
     if (typ_decided < typ_total * 99 / 100 || typ_tri_decided < typ_tri_miss * 9 / 10 || bd == 0 || fd == 0 ||
         td == 0 || typ_tri_hit == 0 || typ_tri_hit_decided < typ_tri_hit * 9 / 10 ||
