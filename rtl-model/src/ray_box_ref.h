@@ -81,19 +81,23 @@ static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
     r->small = 0;
 }
 
-/* The binary32 lanes' part of the preparation (docs/traversal.md §16), after
- * cbvh_ref_prepare: r->small, and o, 1 / d (RN32) and tmin in binary32
- * where small. */
+/* The binary32 lanes' preparation (docs/traversal.md §16), alone or after
+ * cbvh_ref_prepare: r->small, and where small r->general = 0, the planes'
+ * order (pn4, pf4) and o, 1 / d (RN32) and tmin in binary32 - all that the
+ * lanes read, so a small ray needs no binary64 preparation. */
 static inline void cbvh_ref_prepare32(const cbvh_ray *ray, cbvh_ref_ray *r) {
-    int small = !r->general;
+    int small = !(cbvh_float_of(ray->tmin) < 0);
     for (int a = 0; a < 3; a++) {
         float o = cbvh_float_of(ray->o[a]), d = cbvh_float_of(ray->d[a]);
         small &= fabsf(o) <= CBVH_REF32_LIMIT && fabsf(d) >= 1.0f / CBVH_REF32_LIMIT && fabsf(d) <= CBVH_REF32_LIMIT;
         r->o32[a] = o;
         r->inv32[a] = small ? 1.0f / d : 0.0f;
+        r->pn4[a] = CBVH_REF4_AT(d < 0, a, 0);
+        r->pf4[a] = CBVH_REF4_AT(!(d < 0), a, 0);
     }
     r->tmin32 = cbvh_float_of(ray->tmin);
     r->small = small;
+    if (small) r->general = 0; /* d != 0 and tmin >= 0 */
 }
 
 /* Two boxes (lo <= hi, finite) against [tmin, cull] for a ray without zero

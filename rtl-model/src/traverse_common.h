@@ -14,7 +14,8 @@
 typedef struct {
     const cbvh_ray *ray;
     cbvh_rb_ray prep; /* the ray prepared once for the box unit's fast path */
-    cbvh_tri_ray tprep; /* ... and for the triangle unit's filter (trav_set_ray) */
+    cbvh_tri_ray tprep; /* ... and for the triangle unit's filter, at its first triangle */
+    int tprep_ready;
     const cbvh_tri *tris;
     cbvh_trav_mode mode;
     int M;
@@ -24,11 +25,12 @@ typedef struct {
     int done; /* any-hit found */
 } trav_state;
 
-/* The ray, and its preparation for the triangle unit (every traversal; the
- * ray has passed cbvh_rb_ray_status, so its o and d are finite, d != 0). */
+/* The ray (every traversal; it has passed cbvh_rb_ray_status, so its o and
+ * d are finite, d != 0); its preparation for the triangle unit is made at
+ * its first triangle (most rays of a wide view test none). */
 static inline void trav_set_ray(trav_state *ts, const cbvh_ray *ray) {
     ts->ray = ray;
-    cbvh_tri_ray_prepare_valid(ray, &ts->tprep);
+    ts->tprep_ready = 0;
 }
 
 static inline uint64_t trav_align(uint64_t a) { return (a + CBVH_LINE_BYTES - 1) / CBVH_LINE_BYTES * CBVH_LINE_BYTES; }
@@ -81,6 +83,10 @@ static inline cbvh_f32 trav_box_tmax(const trav_state *ts) {
 static inline void trav_triangle_v(trav_state *ts, uint32_t id, const cbvh_f32 v[3][3]) {
     trav_fetch(ts, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
     ts->s.tri_tests++;
+    if (!ts->tprep_ready) {
+        cbvh_tri_ray_prepare_valid(ts->ray, &ts->tprep);
+        ts->tprep_ready = 1;
+    }
     cbvh_tri_result r;
 #if CBVH_REF_AVX
     /* the wide AVX loop (§15): the unit's filter in lanes decides nearly every

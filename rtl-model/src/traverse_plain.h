@@ -37,12 +37,14 @@ static inline int plain_pop(const plain_entry *stack, int *sp, double cull, uint
 
 /* The root's box test (one box test counted) with §5's culling bound, the
  * same for every plain traversal: 1 if the ray may meet the root.  *cull
- * receives the bound. */
+ * receives the bound.  In binary32 lanes for a small ray (r->small: only
+ * where the tree's planes are small too, §16), else in binary64. */
 static inline int plain_root(trav_state *ts, const cbvh_ref_ray *r, const float root_box[12], double *cull) {
     int h[2];
     double tl[2];
     *cull = cbvh_float_of(trav_box_tmax(ts)); /* no acceptable triangle culled */
     ts->s.box_tests++;
+    if (r->small) return cbvh_ref_boxw32_c(r, root_box, 2, (float)*cull, tl) & 1;
     cbvh_ref_box2_for(r, root_box, *cull, h, tl);
     return h[0];
 }

@@ -78,12 +78,13 @@ static inline int wide_trace(int W, const wide_tree *f, const cbvh_tri *tris, co
     if (trav_begin(&ts, hit, ray, CBVH_MANT_MAX, tris, mode, (uint64_t)f->nrecs * WIDE_REC_BYTES(W), f->nprims))
         return -1;
     cbvh_ref_ray r;
-    cbvh_ref_prepare(ray, &r);
-    int small = 0; /* the binary32 lanes run (§16) */
+    r.tmin = 0, r.tmin32 = 0; /* each set below where read (GCC cannot tell) */
+    int small = 0; /* the binary32 lanes run (§16), the root test too; no binary64 preparation */
     if (f->small_planes && cbvh_wide_float_box32_on()) {
         cbvh_ref_prepare32(ray, &r);
         small = r.small;
     }
+    if (!small) cbvh_ref_prepare(ray, &r);
     const cbvh_cbvh_dtri *lt = f->leaf_tris && f->leaf_src == tris ? f->leaf_tris : NULL;
     const unsigned char *recs = f->recs;
     plain_entry stack[CBVH_TRAV_STACK];

@@ -639,6 +639,15 @@ static void test_small_rays(void) {
                 failures++;
             }
             cbvh_ref_prepare32(&ray, &r);
+            cbvh_ref_ray alone; /* without cbvh_ref_prepare, as the wide loop takes a small ray */
+            memset(&alone, 0x5A, sizeof alone);
+            cbvh_ref_prepare32(&ray, &alone);
+            if (alone.small != r.small ||
+                (r.small && (alone.general || memcmp(alone.pn4, r.pn4, sizeof r.pn4) ||
+                             memcmp(alone.pf4, r.pf4, sizeof r.pf4) || memcmp(alone.inv32, r.inv32, sizeof r.inv32)))) {
+                printf("FAIL small rays: case %zu axis %d: cbvh_ref_prepare32 alone differs\n", k, a);
+                failures++;
+            }
             int inv_ok = 1;
             for (int b = 0; b < 3 && r.small; b++) inv_ok &= r.inv32[b] == 1.0f / bf(ray.d[b]);
             if (r.small != cases[k].small || !inv_ok) {
