@@ -37,6 +37,8 @@
 /* The binary32 lanes (docs/traversal.md §16): magnitudes of origins, planes
  * and directions (and their inverses) within 2^62, and the margins. */
 #define CBVH_REF32_LIMIT 0x1p62f
+#define CBVH_REF32_LIMIT_BITS 0x5E800000u  /* 2^62 as binary32 */
+#define CBVH_REF32_RLIMIT_BITS 0x20800000u /* 2^-62 */
 #define CBVH_REF32_C0 (1.0f - 0x1p-20f)
 #define CBVH_REF32_C1 (1.0f + 0x1p-20f)
 #define CBVH_REF32_H 0x1p-140f
@@ -83,20 +85,25 @@ static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
 
 /* The binary32 lanes' preparation (docs/traversal.md §16), alone or after
  * cbvh_ref_prepare: r->small, and where small r->general = 0, the planes'
- * order (pn4, pf4) and o, 1 / d (RN32) and tmin in binary32 - all that the
- * lanes read, so a small ray needs no binary64 preparation. */
+ * order (pn, pf, pn4, pf4) and o, 1 / d (RN32) and tmin in binary32 - all
+ * that the lanes read, so a small ray needs no binary64 preparation. */
 static inline void cbvh_ref_prepare32(const cbvh_ray *ray, cbvh_ref_ray *r) {
-    int small = !(cbvh_float_of(ray->tmin) < 0);
+    /* the limits as tests of the magnitude's bit pattern (branch-free; NaN's
+     * is above 2^62's): |o| <= 2^62 and 2^-62 <= |d| <= 2^62 */
+    uint32_t small = !(cbvh_float_of(ray->tmin) < 0);
     for (int a = 0; a < 3; a++) {
-        float o = cbvh_float_of(ray->o[a]), d = cbvh_float_of(ray->d[a]);
-        small &= fabsf(o) <= CBVH_REF32_LIMIT && fabsf(d) >= 1.0f / CBVH_REF32_LIMIT && fabsf(d) <= CBVH_REF32_LIMIT;
-        r->o32[a] = o;
-        r->inv32[a] = small ? 1.0f / d : 0.0f;
+        uint32_t mo = ray->o[a] & 0x7FFFFFFFu, md = ray->d[a] & 0x7FFFFFFFu;
+        small &= (mo <= CBVH_REF32_LIMIT_BITS) & (md - CBVH_REF32_RLIMIT_BITS <= CBVH_REF32_LIMIT_BITS - CBVH_REF32_RLIMIT_BITS);
+        float d = cbvh_float_of(ray->d[a]);
+        r->o32[a] = cbvh_float_of(ray->o[a]);
+        r->pn[a] = CBVH_REF_AT(d < 0, a, 0);
+        r->pf[a] = CBVH_REF_AT(!(d < 0), a, 0);
         r->pn4[a] = CBVH_REF4_AT(d < 0, a, 0);
         r->pf4[a] = CBVH_REF4_AT(!(d < 0), a, 0);
     }
+    for (int a = 0; a < 3; a++) r->inv32[a] = small ? 1.0f / cbvh_float_of(ray->d[a]) : 0.0f;
     r->tmin32 = cbvh_float_of(ray->tmin);
-    r->small = small;
+    r->small = (int)small;
     if (small) r->general = 0; /* d != 0 and tmin >= 0 */
 }
 
@@ -290,22 +297,32 @@ static inline int cbvh_ref_box8(const cbvh_ref_ray *r, const float box[48], doub
 /* The binary32 lanes of docs/traversal.md §16, for a small ray (r->small)
  * and planes of magnitude <= 2^62: per box and axis T = RN32(RN32(p - o) *
  * inv32), N = max(tmin, T_near...), F = min(cull, T_far...), hit when
- * N <= RN32(RN32(F * C1) + H), t_lo = RN32(RN32(N * C0) - H) widened.  w
- * boxes (4 or 8), plane of axis a of box c at ((plane * 3) + a) * w + c; cull
- * a binary32 value.  Returns the hit mask (bit c for box c). */
+ * N <= RN32(RN32(F * C1) + H), t_lo = RN32(RN32(N * C0) - H) widened.  One
+ * box, its near and far planes of axis a at box[pn[a]], box[pf[a]] (the
+ * root's test: r->pn, r->pf); cull a binary32 value.  Returns 1 on a hit. */
+static inline int cbvh_ref_box32_one(const cbvh_ref_ray *r, const float *box, const int pn[3], const int pf[3],
+                                     float cull, double *t_lo) {
+    float n = r->tmin32, f = cull;
+    for (int a = 0; a < 3; a++) {
+        float tn = (box[pn[a]] - r->o32[a]) * r->inv32[a];
+        float tf = (box[pf[a]] - r->o32[a]) * r->inv32[a];
+        n = tn > n ? tn : n;
+        f = tf < f ? tf : f;
+    }
+    float lo = n * CBVH_REF32_C0, hi = f * CBVH_REF32_C1;
+    *t_lo = (double)(lo - CBVH_REF32_H);
+    return n <= hi + CBVH_REF32_H;
+}
+
+/* The same for all w boxes of a row (2, 4 or 8; plane of axis a of box c at
+ * ((plane * 3) + a) * w + c): the hit mask, bit c for box c - what the SIMD
+ * versions below compute lane by lane. */
 static inline int cbvh_ref_boxw32_c(const cbvh_ref_ray *r, const float *box, int w, float cull, double *t_lo) {
     int m = 0;
     for (int c = 0; c < w; c++) {
-        float n = r->tmin32, f = cull;
-        for (int a = 0; a < 3; a++) {
-            float tn = (box[r->pn4[a] / 4 * w + c] - r->o32[a]) * r->inv32[a];
-            float tf = (box[r->pf4[a] / 4 * w + c] - r->o32[a]) * r->inv32[a];
-            n = tn > n ? tn : n;
-            f = tf < f ? tf : f;
-        }
-        float lo = n * CBVH_REF32_C0, hi = f * CBVH_REF32_C1;
-        t_lo[c] = (double)(lo - CBVH_REF32_H);
-        m |= (n <= hi + CBVH_REF32_H) << c;
+        int pn[3], pf[3];
+        for (int a = 0; a < 3; a++) pn[a] = r->pn4[a] / 4 * w + c, pf[a] = r->pf4[a] / 4 * w + c;
+        m |= cbvh_ref_box32_one(r, box, pn, pf, cull, t_lo + c) << c;
     }
     return m;
 }

@@ -44,7 +44,7 @@ static inline int plain_root(trav_state *ts, const cbvh_ref_ray *r, const float 
     double tl[2];
     *cull = cbvh_float_of(trav_box_tmax(ts)); /* no acceptable triangle culled */
     ts->s.box_tests++;
-    if (r->small) return cbvh_ref_boxw32_c(r, root_box, 2, (float)*cull, tl) & 1;
+    if (r->small) return cbvh_ref_box32_one(r, root_box, r->pn, r->pf, (float)*cull, tl);
     cbvh_ref_box2_for(r, root_box, *cull, h, tl);
     return h[0];
 }

@@ -577,6 +577,12 @@ static void test_ref_lanes(void) {
                 n32_hit += a8 != 0;
                 if ((a4 != c4 || memcmp(v4, w4, sizeof v4) || a8 != c8 || memcmp(v8, w8, sizeof v8)) && failures++ < 10)
                     printf("FAIL ref lanes %ld: binary32 lanes %x/%x differ from the plain C %x/%x\n", i, a4, a8, c4, c8);
+                for (int k = 0; k < 2; k++) { /* the root's test: one box of a two-box row, at r.pn / r.pf */
+                    double w2[2], v1;
+                    int c2 = cbvh_ref_boxw32_c(&r, b2[k], 2, c32, w2), a1 = cbvh_ref_box32_one(&r, b2[k], r.pn, r.pf, c32, &v1);
+                    if ((a1 != (c2 & 1) || memcmp(&v1, &w2[0], sizeof v1)) && failures++ < 10)
+                        printf("FAIL ref lanes %ld: the root's binary32 test %d differs from the row's %d\n", i, a1, c2 & 1);
+                }
             }
             int h2[2];
             double t2[2];
@@ -624,7 +630,10 @@ static void test_small_rays(void) {
     } cases[] = {{0, 0x5E800000u, 1},  {0, 0x5E800001u, 0}, {0, 0xDE800000u, 1}, {0, 0xDE800001u, 0},
                  {0, 0, 1},            {0, 0x00000001u, 1}, {1, 0x5E800000u, 1}, {1, 0x5E800001u, 0},
                  {1, 0xA0800000u, 1},  {1, 0xA07FFFFFu, 0}, {1, 0x20800000u, 1}, {1, 0, 0},
-                 {1, CBVH_F32_SIGN, 0}, {2, 0xBF800000u, 0}, {2, CBVH_F32_SIGN, 1}, {2, 0x7F7FFFFFu, 1}};
+                 {1, CBVH_F32_SIGN, 0}, {2, 0xBF800000u, 0}, {2, CBVH_F32_SIGN, 1}, {2, 0x7F7FFFFFu, 1},
+                 /* beyond the limits' bit patterns: Inf and NaN (o, d), the largest and smallest magnitudes */
+                 {0, 0x7F800000u, 0},  {0, 0xFFC00000u, 0}, {1, 0x7F800000u, 0}, {1, 0x7FC00001u, 0},
+                 {0, 0x7F7FFFFFu, 0},  {1, 0x00000001u, 0}, {1, 0x80000001u, 0}, {1, 0x7F7FFFFFu, 0}};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++)
         for (int a = 0; a < 3; a++) {
             cbvh_ray ray = {{0x3F800000u, 0xBF800000u, 0x40000000u}, {0x3F000000u, 0x3F800000u, 0xBF800000u}, 0,
@@ -644,6 +653,7 @@ static void test_small_rays(void) {
             cbvh_ref_prepare32(&ray, &alone);
             if (alone.small != r.small ||
                 (r.small && (alone.general || memcmp(alone.pn4, r.pn4, sizeof r.pn4) ||
+                             memcmp(alone.pn, r.pn, sizeof r.pn) || memcmp(alone.pf, r.pf, sizeof r.pf) ||
                              memcmp(alone.pf4, r.pf4, sizeof r.pf4) || memcmp(alone.inv32, r.inv32, sizeof r.inv32)))) {
                 printf("FAIL small rays: case %zu axis %d: cbvh_ref_prepare32 alone differs\n", k, a);
                 failures++;
