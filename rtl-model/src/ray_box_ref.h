@@ -63,6 +63,15 @@ typedef struct {
     _Alignas(16) double o2[3][2], inv2[3][2]; /* o, inv twice: an SSE2 register's two lanes */
 } cbvh_ref_ray;
 
+/* Axis a's near and far plane offsets, for both layouts (both preparations):
+ * the near plane is hi where d_a < 0. */
+static inline void cbvh_ref_plane_order(cbvh_ref_ray *r, int a, int neg) {
+    r->pn[a] = CBVH_REF_AT(neg, a, 0);
+    r->pf[a] = CBVH_REF_AT(!neg, a, 0);
+    r->pn4[a] = CBVH_REF4_AT(neg, a, 0);
+    r->pf4[a] = CBVH_REF4_AT(!neg, a, 0);
+}
+
 /* For a ray the units accept (finite, d != 0). */
 static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
     int axis_par = 0;
@@ -70,10 +79,7 @@ static inline void cbvh_ref_prepare(const cbvh_ray *ray, cbvh_ref_ray *r) {
         double d = cbvh_float_of(ray->d[a]);
         r->o[a] = cbvh_float_of(ray->o[a]);
         r->inv[a] = d != 0 ? 1.0 / d : 0;
-        r->pn[a] = CBVH_REF_AT(d < 0, a, 0);
-        r->pf[a] = CBVH_REF_AT(!(d < 0), a, 0);
-        r->pn4[a] = CBVH_REF4_AT(d < 0, a, 0);
-        r->pf4[a] = CBVH_REF4_AT(!(d < 0), a, 0);
+        cbvh_ref_plane_order(r, a, d < 0);
         r->o2[a][0] = r->o2[a][1] = r->o[a];
         r->inv2[a][0] = r->inv2[a][1] = r->inv[a];
         axis_par |= d == 0;
@@ -96,10 +102,7 @@ static inline void cbvh_ref_prepare32(const cbvh_ray *ray, cbvh_ref_ray *r) {
         small &= (mo <= CBVH_REF32_LIMIT_BITS) & (md - CBVH_REF32_RLIMIT_BITS <= CBVH_REF32_LIMIT_BITS - CBVH_REF32_RLIMIT_BITS);
         float d = cbvh_float_of(ray->d[a]);
         r->o32[a] = cbvh_float_of(ray->o[a]);
-        r->pn[a] = CBVH_REF_AT(d < 0, a, 0);
-        r->pf[a] = CBVH_REF_AT(!(d < 0), a, 0);
-        r->pn4[a] = CBVH_REF4_AT(d < 0, a, 0);
-        r->pf4[a] = CBVH_REF4_AT(!(d < 0), a, 0);
+        cbvh_ref_plane_order(r, a, d < 0);
     }
     for (int a = 0; a < 3; a++) r->inv32[a] = small ? 1.0f / cbvh_float_of(ray->d[a]) : 0.0f;
     r->tmin32 = cbvh_float_of(ray->tmin);
