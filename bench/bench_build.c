@@ -2,9 +2,15 @@
  * build vs the float LBVH build in the same run, top-down compression, and
  * CBVH bytes vs float BVH bytes.
  *
- * usage: bench_build [--reps R] [SCENE...]
+ * usage: bench_build [--reps R] [--warm] [SCENE...]
  *   SCENE as for `cbvh study` (file or proc:NAME[:SIZE]); default: the bundled
  *   bunny and proc:instanced (10.24 M triangles).
+ *   --warm: glibc keeps freed memory (no mmap for large blocks, no trimming)
+ *   and one untimed repetition runs first, so the timed builds reuse pages
+ *   already touched.  Without it every large buffer is fresh memory, and on
+ *   a VM whose host backs a page at first touch that cost (measured up to
+ *   ~12 us per 4 KiB page) lands in both sides of every ratio
+ *   (docs/results.md, "Fused LBVH + streaming compression").
  * Times are the best of R repetitions (default 3), one core.  Both sides of
  * the ratio build the LBVH the same way (Morton codes, sort and all): the
  * float build alone, and the float build followed by the streaming
@@ -17,10 +23,15 @@
  * fused/lbvh the ratio of the bests and fused_med the median over
  * repetitions of fused / LBVH with both from the same repetition. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
@@ -47,25 +58,41 @@ static void die(const char *what, const char *err) {
 }
 
 int main(int argc, char **argv) {
-    int reps = 3;
+    int reps = 3, warm = 0;
     const char *specs[64];
     int ns = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
-            reps = atoi(argv[++i]);
-            if (reps < 1 || reps > 100) die("--reps", "must be 1..100");
+            char *end;
+            errno = 0;
+            long v = strtol(argv[++i], &end, 10);
+            if (errno || end == argv[i] || *end || v < 1 || v > 100) die("--reps", "must be an integer 1..100");
+            reps = (int)v;
+        } else if (!strcmp(argv[i], "--warm")) {
+#if defined(__GLIBC__)
+            warm = 1;
+#else
+            die("--warm", "needs glibc's mallopt");
+#endif
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: bench_build [--reps R] [SCENE...]\n");
+            fprintf(stderr, "usage: bench_build [--reps R] [--warm] [SCENE...]\n");
             return 2;
         } else if (ns < 64) {
             specs[ns++] = argv[i];
+        } else {
+            die(argv[i], "at most 64 scenes");
         }
     }
+#if defined(__GLIBC__)
+    if (warm && (!mallopt(M_MMAP_MAX, 0) || !mallopt(M_TRIM_THRESHOLD, INT_MAX)))
+        die("--warm", "mallopt refused the settings");
+#endif
     if (!ns) {
         specs[ns++] = CBVH_SCENES_DIR "/bunny-small.obj";
         specs[ns++] = "proc:instanced";
     }
     char err[512];
+    if (warm) printf("# --warm: freed memory kept for reuse, one untimed repetition first\n");
     printf("%-24s %10s %10s %9s %9s %9s %9s %7s %9s %7s %9s %11s %9s %11s %11s %6s\n", "scene", "triangles", "lbvh_ms",
            "Mtri/s", "lbvh+bu", "bu_ms", "lbvh+td", "bu/lbvh", "run_ratio", "td/lbvh", "fused_ms", "fused/lbvh",
            "fused_med", "cbvh_bytes", "float_bytes", "ratio");
@@ -76,7 +103,7 @@ int main(int argc, char **argv) {
         double best_l = 1e30, best_bu = 1e30, best_td = 1e30, best_c = 1e30, best_run = 1e30, best_f = 1e30,
                fr[100] = {0};
         size_t cb = 0, fb = 0;
-        for (int r = 0; r < reps; r++) {
+        for (int r = -warm; r < reps; r++) { /* r < 0: the untimed warm-up */
             cbvh_bvh b;
             cbvh_tree t;
             cbvh_bu_stats st;
@@ -93,16 +120,16 @@ int main(int argc, char **argv) {
             size_t fused_bytes = cbvh_tree_bytes(&t);
             cbvh_tree_free(&t);
             cbvh_bvh_free(&b);
-            if (t7 - t6 < best_f) best_f = t7 - t6;
-            fr[r] = (t7 - t6) / (t1 - t0);
+            if (r >= 0 && t7 - t6 < best_f) best_f = t7 - t6;
+            if (r >= 0) fr[r] = (t7 - t6) / (t1 - t0);
             /* LBVH + streaming bottom-up compression (the CBVH build) */
             double t2 = now();
             if (cbvh_build_lbvh(&s, &b, err, sizeof err)) die(specs[i], err);
             double t2c = now();
             if (cbvh_compress_bottomup(&b, NULL, &o, &t, &st, err, sizeof err)) die(specs[i], err);
             double t3 = now();
-            if (t3 - t2c < best_c) best_c = t3 - t2c;
-            if ((t3 - t2) / (t2c - t2) < best_run) best_run = (t3 - t2) / (t2c - t2);
+            if (r >= 0 && t3 - t2c < best_c) best_c = t3 - t2c;
+            if (r >= 0 && (t3 - t2) / (t2c - t2) < best_run) best_run = (t3 - t2) / (t2c - t2);
             cb = cbvh_tree_bytes(&t);
             if (fused_bytes != cb) die(specs[i], "fused build: CBVH size differs");
             fb = cbvh_bvh_bytes(&b);
@@ -115,6 +142,7 @@ int main(int argc, char **argv) {
             double t5 = now();
             cbvh_tree_free(&t);
             cbvh_bvh_free(&b);
+            if (r < 0) continue;
             if (t1 - t0 < best_l) best_l = t1 - t0;
             if (t3 - t2 < best_bu) best_bu = t3 - t2;
             if (t5 - t4 < best_td) best_td = t5 - t4;
