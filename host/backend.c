@@ -1,4 +1,5 @@
 #include "backend.h"
+#include "cbvh_sim.h"
 #include "protocol.h"
 
 #include <stdlib.h>
@@ -31,8 +32,6 @@ int cbvh_usb_identity(uint16_t *vid, uint16_t *pid, char *err, size_t errlen) {
     return 0;
 }
 
-static const cbvh_backend_ops *const probe_order[] = {&cbvh_backend_usb, &cbvh_backend_hid};
-
 static int open_one(const cbvh_backend_ops *ops, const char *arg, cbvh_backend *b, char *err, size_t errlen) {
     memset(b, 0, sizeof *b);
     b->ops = ops;
@@ -42,25 +41,50 @@ static int open_one(const cbvh_backend_ops *ops, const char *arg, cbvh_backend *
     return rc;
 }
 
-int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen) {
-    if (strcmp(spec, "auto") == 0) {
-        /* Bad settings are an error, not a reason to fall back to the model. */
-        uint16_t vid, pid;
-        if (cbvh_usb_identity(&vid, &pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen)) return -1;
-        char why[2][200] = {"", ""};
-        for (size_t i = 0; i < sizeof probe_order / sizeof probe_order[0]; i++) {
-            int rc = open_one(probe_order[i], NULL, b, why[i], sizeof why[i]);
-            if (rc == CBVH_BACKEND_OK) return 0;
-        }
-        if (log)
-            fprintf(log, "cbvh: no board found (usb: %s; hid: %s); using the software model\n", why[0], why[1]);
-        return open_one(&cbvh_backend_model, NULL, b, err, errlen) == CBVH_BACKEND_OK ? 0 : -1;
+/* auto: the boards `cbvh devices` lists, in its order (usb, hid, then the
+ * virtual board at CBVH_SIM_ADDR when that is set), else the model. */
+static int open_auto(cbvh_backend *b, FILE *log, char *err, size_t errlen) {
+    /* Bad settings are an error, not a reason to fall back to the model. */
+    uint16_t vid, pid;
+    if (cbvh_usb_identity(&vid, &pid, err, errlen) || cbvh_link_env_options(NULL, err, errlen)) return -1;
+    const char *sim = getenv("CBVH_SIM_ADDR"); /* empty means unset, as for `cbvh devices` */
+    char why_sim[220];
+    if (sim && *sim && cbvh_sim_addr_check(sim, why_sim, sizeof why_sim)) {
+        snprintf(err, errlen, "CBVH_SIM_ADDR: %s", why_sim);
+        return -1;
     }
+    char why[3][240] = {"", "", ""};
+    if (open_one(&cbvh_backend_usb, NULL, b, why[0], sizeof why[0]) == CBVH_BACKEND_OK) return 0;
+    if (open_one(&cbvh_backend_hid, NULL, b, why[1], sizeof why[1]) == CBVH_BACKEND_OK) return 0;
+    if (sim && *sim) {
+        int rc = open_one(&cbvh_backend_sim, sim, b, why[2], sizeof why[2]);
+        if (rc == CBVH_BACKEND_OK) return 0;
+        if (rc == CBVH_BACKEND_BAD_INPUT) { /* e.g. a bad CBVH_LINK_FAULTS: an error, as for usb's settings */
+            snprintf(err, errlen, "sim backend at CBVH_SIM_ADDR=%.100s: %s", sim, why[2]);
+            return -1;
+        }
+    }
+    if (log) {
+        if (sim && *sim)
+            fprintf(log, "cbvh: no board found (usb: %s; hid: %s; sim: %s); using the software model\n", why[0], why[1],
+                    why[2]);
+        else
+            fprintf(log, "cbvh: no board found (usb: %s; hid: %s); using the software model\n", why[0], why[1]);
+    }
+    return open_one(&cbvh_backend_model, NULL, b, err, errlen) == CBVH_BACKEND_OK ? 0 : -1;
+}
+
+int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen) {
+    if (strcmp(spec, "auto") == 0) return open_auto(b, log, err, errlen);
     const cbvh_backend_ops *all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid, &cbvh_backend_sim};
     size_t n = strcspn(spec, ":");
     const char *arg = spec[n] == ':' ? spec + n + 1 : NULL;
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
         if (strlen(all[i]->name) == n && strncmp(all[i]->name, spec, n) == 0) {
+            if (arg && all[i] == &cbvh_backend_model) { /* an ignored argument would hide a typo */
+                snprintf(err, errlen, "the model backend takes no argument (got '%.100s'; use 'model')", spec);
+                return -1;
+            }
             int rc = open_one(all[i], arg, b, err, errlen);
             if (rc == CBVH_BACKEND_NONE && err[0] == '\0') snprintf(err, errlen, "no %s board found", all[i]->name);
             return rc == CBVH_BACKEND_OK ? 0 : -1;

@@ -3,8 +3,11 @@
  *   backend_model.c   in-process bit-exact model
  *   transport_usb.c   libusb bulk (board)
  *   transport_hid.c   hidapi HID (board)
- * `auto` probes usb, then hid, then falls back to the model with one line
- * (but not over bad CBVH_USB_* / CBVH_LINK_* settings: those are an error). */
+ *   transport_socket.c  the virtual board (`cbvh board-sim`) on a socket
+ * `auto` probes in the order `cbvh devices` lists: usb, hid, then sim when
+ * CBVH_SIM_ADDR is set, and falls back to the model with one line (but not
+ * over bad CBVH_USB_* / CBVH_LINK_* / CBVH_SIM_ADDR settings: those are an
+ * error). */
 #ifndef CBVH_HOST_BACKEND_H
 #define CBVH_HOST_BACKEND_H
 
@@ -20,7 +23,9 @@ typedef struct {
     const char *name;
     /* Opens the backend; arg is the text after "name:" (or NULL).
      * Returns 0 on success, CBVH_BACKEND_NONE when no device is present,
-     * CBVH_BACKEND_ERROR on any other failure (err says why, one line). */
+     * CBVH_BACKEND_BAD_INPUT when arg or a setting is wrong (auto then fails
+     * instead of falling back), CBVH_BACKEND_ERROR on any other failure (err
+     * says why, one line). */
     int (*open)(cbvh_backend *b, const char *arg, char *err, size_t errlen);
     void (*close)(cbvh_backend *b);
     /* Runs count vectors of unit: in holds count*n_in words, out receives
@@ -29,7 +34,7 @@ typedef struct {
                uint32_t *out, size_t count, char *err, size_t errlen);
 } cbvh_backend_ops;
 
-enum { CBVH_BACKEND_OK = 0, CBVH_BACKEND_NONE = 1, CBVH_BACKEND_ERROR = 2 };
+enum { CBVH_BACKEND_OK = 0, CBVH_BACKEND_NONE = 1, CBVH_BACKEND_ERROR = 2, CBVH_BACKEND_BAD_INPUT = 3 };
 
 struct cbvh_backend {
     const cbvh_backend_ops *ops;
@@ -42,8 +47,9 @@ extern const cbvh_backend_ops cbvh_backend_usb;
 extern const cbvh_backend_ops cbvh_backend_hid;
 extern const cbvh_backend_ops cbvh_backend_sim; /* transport_socket.c: "sim:ADDR", the virtual board */
 
-/* Opens by spec: "auto", "model", "usb", "hid", "sim:ADDR".  For auto,
- * writes one line to log when no board is found.  0 on success. */
+/* Opens by spec: "auto", "model", "usb[:SERIAL]", "hid[:SERIAL]", "sim:ADDR"
+ * ("model:ARG" is refused).  For auto, writes one line to log when no board
+ * is found.  0 on success. */
 int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen);
 void cbvh_backend_close(cbvh_backend *b);
 

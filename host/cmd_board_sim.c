@@ -1,5 +1,4 @@
 /* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
-#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,14 +24,29 @@ static void usage(FILE *f) {
                "  or with --gateware the board's RTL simulated by Icarus Verilog (PROG from\n"
                "  gateware/scripts/build-board-sim), driven over SPI as on the board;\n"
                "  reachable with --backend sim:ADDR.  ADDR: unix:PATH (default unix:/tmp/cbvh-board-UID.sock)\n"
-               "  or tcp:HOST:PORT (PORT 1..65535).  --faults injects faults into the replies, e.g.\n"
+               "  or tcp:HOST:PORT (PORT 1..65535); a stale unix socket left by a crashed board is replaced.\n"
+               "  --faults injects faults into the replies, e.g.\n"
                "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1\n"
                "  (rates in [0,1] adding up to at most 1, delay_ms 0..10000, seed a non-negative integer).\n"
                "  --rx-idle-ms N: the firmware's inter-byte timeout, 1..60000 (default 20).\n"
                "  --break-unit UNIT flips bit 0 of the unit's first output word (a test aid that\n"
                "  plays a gateware bug: checks against this board must fail).\n"
-               "  Stops on SIGINT/SIGTERM and removes its socket file.\n");
+               "  Stops on SIGINT/SIGTERM and removes its socket file.\n"
+               "  Exit status: 0 stopped by SIGINT/SIGTERM while idle; 1 the board failed (ADDR cannot\n"
+               "  be listened on or another board listens there, the gateware simulation ended or hung,\n"
+               "  or a stop abandoned a gateware transaction in progress); 2 bad options or values.\n");
 }
+
+/* What each option's value is, for the one-line error when it is missing. */
+static const struct {
+    const char *name, *value;
+} valued_options[] = {
+    {"--listen", "unix:PATH or tcp:HOST:PORT"},
+    {"--gateware", "a program from gateware/scripts/build-board-sim"},
+    {"--faults", "a fault spec, e.g. drop=0.01,seed=1"},
+    {"--rx-idle-ms", "an integer in 1..60000"},
+    {"--break-unit", "a unit name, e.g. axis_compress"},
+};
 
 int cmd_board_sim(int argc, char **argv) {
     char def[128];
@@ -43,33 +57,44 @@ int cmd_board_sim(int argc, char **argv) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
             return 0;
-        } else if (strcmp(argv[i], "--listen") == 0 && i + 1 < argc) {
-            addr = argv[++i];
-        } else if (strcmp(argv[i], "--gateware") == 0 && i + 1 < argc) {
-            gateware = argv[++i];
-        } else if (strcmp(argv[i], "--faults") == 0 && i + 1 < argc) {
-            faults = argv[++i];
-        } else if (strcmp(argv[i], "--rx-idle-ms") == 0 && i + 1 < argc) {
+        }
+        if (strcmp(argv[i], "--verbose") == 0) {
+            verbose = 1;
+            continue;
+        }
+        const char *value_is = NULL;
+        for (size_t k = 0; k < sizeof valued_options / sizeof valued_options[0]; k++)
+            if (strcmp(argv[i], valued_options[k].name) == 0) value_is = valued_options[k].value;
+        if (!value_is) {
+            fprintf(stderr, "cbvh board-sim: unknown option '%s' (cbvh board-sim --help)\n", argv[i]);
+            return 2;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "cbvh board-sim: %s needs a value (%s)\n", argv[i], value_is);
+            return 2;
+        }
+        const char *opt = argv[i], *val = argv[++i];
+        if (strcmp(opt, "--listen") == 0) {
+            addr = val;
+        } else if (strcmp(opt, "--gateware") == 0) {
+            gateware = val;
+        } else if (strcmp(opt, "--faults") == 0) {
+            faults = val;
+        } else if (strcmp(opt, "--rx-idle-ms") == 0) {
             long v;
-            if (cbvh_parse_long(argv[++i], 1, RX_IDLE_MS_MAX, &v)) {
+            if (cbvh_parse_long(val, 1, RX_IDLE_MS_MAX, &v)) {
                 fprintf(stderr, "cbvh board-sim: --rx-idle-ms expects an integer in 1..%d, got '%s'\n",
-                        RX_IDLE_MS_MAX, argv[i]);
+                        RX_IDLE_MS_MAX, val);
                 return 2;
             }
             idle = (int)v;
-        } else if (strcmp(argv[i], "--break-unit") == 0 && i + 1 < argc) {
-            const cbvh_unit *u = cbvh_unit_find(argv[++i]);
+        } else { /* --break-unit */
+            const cbvh_unit *u = cbvh_unit_find(val);
             if (!u) {
-                fprintf(stderr, "cbvh board-sim: --break-unit: unknown unit '%s'\n", argv[i]);
+                fprintf(stderr, "cbvh board-sim: --break-unit: unknown unit '%s'\n", val);
                 return 2;
             }
             broken = u->id;
-        } else if (strcmp(argv[i], "--verbose") == 0) {
-            verbose = 1;
-        } else {
-            fprintf(stderr, "cbvh board-sim: unknown or incomplete option '%s'\n", argv[i]);
-            usage(stderr);
-            return 2;
         }
     }
     char err[256];
@@ -83,9 +108,8 @@ int cmd_board_sim(int argc, char **argv) {
         return 2;
     }
     cbvh_gateware *gw = NULL;
-    if (gateware && access(gateware, R_OK) != 0) { /* bad input: exit 2, as a bad address */
-        fprintf(stderr, "cbvh board-sim: --gateware: cannot read '%s': %s (build it with gateware/scripts/build-board-sim)\n",
-                gateware, strerror(errno));
+    if (gateware && cbvh_gateware_check(gateware, err, sizeof err)) { /* bad input: exit 2, as a bad address */
+        fprintf(stderr, "cbvh board-sim: --gateware: %s\n", err);
         return 2;
     }
     if (gateware && !(gw = cbvh_gateware_start(gateware, broken, err, sizeof err))) {

@@ -12,8 +12,9 @@ int cmd_devices(int argc, char **argv) {
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             printf("usage: cbvh devices [--sim ADDR]\n"
-                   "  Lists boards per backend: usb (libusb bulk), hid (hidapi), sim (a virtual board at ADDR,\n"
-                   "  also from CBVH_SIM_ADDR) and the always-present model.  VID:PID from CBVH_USB_VID/PID.\n"
+                   "  Lists boards per backend, in the order --backend auto tries them: usb (libusb bulk),\n"
+                   "  hid (hidapi), sim (a virtual board at ADDR, also from CBVH_SIM_ADDR, which auto uses)\n"
+                   "  and the always-present model.  VID:PID from CBVH_USB_VID/PID.\n"
                    "  Exit 2 on a bad ADDR or a bad CBVH_USB_VID/PID, CBVH_LINK_TIMEOUT_MS/RETRIES.\n");
             return 0;
         } else if (strcmp(argv[i], "--sim") == 0 && i + 1 < argc) {

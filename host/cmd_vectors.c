@@ -3,6 +3,7 @@
 #include <getopt.h>
 #include <inttypes.h>
 #include <limits.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,7 +38,7 @@ static void usage_gen(FILE *f) {
                "  -l, --level 1|2        1: structured corner cases, random cases and, for the ray units,\n"
                "                         exact-path cases (default); 2: plus %d random vectors per file\n"
                "                         and %d more exact-path cases per ray file\n"
-               "  -s, --seed S           generator seed, hex or decimal (default 0x%016" PRIX64 ")\n"
+               "  -s, --seed S           generator seed, decimal or hex after 0x (default 0x%016" PRIX64 ")\n"
                "  -n, --bits N           coordinate bits, %d..%d (default: all)\n"
                "  -m, --min-scale E      minimum scale, %d..%d (default %d)\n"
                "  -e, --encoding E       modulo or relative (default: both)\n"
@@ -65,12 +66,38 @@ static void usage_check(FILE *f) {
             CBVH_CHECK_BATCH);
 }
 
-/* Writes one file through a temp file + rename; returns its SHA-256. */
-static int write_vecfile(const char *dir, const char *name, const cbvh_vecfile *vf, char *hex, char *err,
-                         size_t errlen) {
-    char path[4096], tmp[4200];
+/* ---- gen: every finished file listed at once, nothing half-written ------ */
+
+/* The temp file being written, removed by the signal handler; empty when
+ * none.  Its name and the message are prepared before they are needed, as
+ * the handler may only call async-signal-safe functions. */
+static char gen_tmp[4200];
+static char gen_stop_msg[4400];
+
+static void gen_on_signal(int sig) {
+    if (gen_tmp[0]) unlink(gen_tmp);
+    ssize_t w = write(STDERR_FILENO, gen_stop_msg, strlen(gen_stop_msg));
+    (void)w;
+    _exit(128 + sig);
+}
+
+/* SIGINT/SIGTERM held back while a file is renamed into place and listed, so
+ * that an interrupt never falls between the two. */
+static void gen_block_signals(int block) {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigprocmask(block ? SIG_BLOCK : SIG_UNBLOCK, &set, NULL);
+}
+
+/* Writes one file to DIR/.NAME.tmp.PID (fsync'd) and hashes it;
+ * then, under the directory lock, renames it into place and lists it in
+ * DIR/MANIFEST (re-read just before, so parallel gens keep each other's
+ * entries).  The manifest therefore always vouches for every finished file. */
+static int write_vecfile(const char *dir, const char *name, const cbvh_vecfile *vf, char *err, size_t errlen) {
+    char path[4096], hex[CBVH_SHA256_HEX_LEN + 1];
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
     char *buf = NULL;
     size_t len = 0;
     FILE *mem = open_memstream(&buf, &len);
@@ -85,20 +112,59 @@ static int write_vecfile(const char *dir, const char *name, const cbvh_vecfile *
         snprintf(err, errlen, "%.900s: internal error formatting vectors", path);
         return -1;
     }
-    FILE *f = fopen(tmp, "wb");
+    gen_block_signals(1);
+    snprintf(gen_tmp, sizeof gen_tmp, "%s/.%s.tmp.%ld", dir, name, (long)getpid());
+    gen_block_signals(0);
+    FILE *f = fopen(gen_tmp, "wb");
     if (!f) {
         free(buf);
-        snprintf(err, errlen, "%.900s: cannot create: %s", tmp, strerror(errno));
+        snprintf(err, errlen, "%.900s: cannot create: %s", gen_tmp, strerror(errno));
+        gen_tmp[0] = '\0';
         return -1;
     }
     bad = fwrite(buf, 1, len, f) != len;
+    bad |= fflush(f) != 0 || fsync(fileno(f)) != 0; /* data on disk before the rename makes it visible */
     bad |= fclose(f) != 0;
     free(buf);
-    if (bad || rename(tmp, path) != 0) {
+    if (bad) {
         snprintf(err, errlen, "%.900s: cannot write: %s", path, strerror(errno));
-        remove(tmp);
+        unlink(gen_tmp);
+        gen_tmp[0] = '\0';
         return -1;
     }
+    /* The manifest is read (and must parse) before the rename, so that a
+     * file is only put in place when it can be listed. */
+    gen_block_signals(1);
+    int rc = -1, lock = cbvh_manifest_lock(dir, err, errlen);
+    cbvh_manifest m;
+    if (lock >= 0 && cbvh_manifest_load(dir, &m, err, errlen) >= 0) {
+        if (cbvh_manifest_set(&m, name, hex) != 0)
+            snprintf(err, errlen, "%.900s: cannot list in MANIFEST (bad name or out of memory)", path);
+        else if (rename(gen_tmp, path) != 0)
+            snprintf(err, errlen, "%.900s: cannot write: %s", path, strerror(errno));
+        else
+            rc = cbvh_manifest_save(dir, &m, err, errlen);
+        cbvh_manifest_free(&m);
+    }
+    cbvh_manifest_unlock(lock);
+    unlink(gen_tmp); /* gone after a rename; removed after a failure */
+    gen_tmp[0] = '\0';
+    gen_block_signals(0);
+    return rc;
+}
+
+/* --seed: decimal, or hex after 0x; the whole string, no sign or blanks
+ * (strtoull alone took "010" as octal and " -5" as 2^64 - 5). */
+static int parse_seed(const char *s, uint64_t *out) {
+    int hex = s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+    const char *d = hex ? s + 2 : s;
+    size_t n = strspn(d, hex ? "0123456789abcdefABCDEF" : "0123456789");
+    if (n == 0 || d[n]) return -1;
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(d, &end, hex ? 16 : 10);
+    if (errno || *end) return -1;
+    *out = (uint64_t)v;
     return 0;
 }
 
@@ -133,17 +199,13 @@ static int cmd_gen(int argc, char **argv) {
             }
             sel.level = (int)v;
             break;
-        case 's': {
-            char *end;
-            errno = 0;
-            unsigned long long s = strtoull(optarg, &end, 0);
-            if (errno || end == optarg || *end || optarg[0] == '-') {
-                fprintf(stderr, "cbvh vectors gen: --seed '%s' is not a 64-bit number\n", optarg);
+        case 's':
+            if (parse_seed(optarg, &sel.seed) != 0) {
+                fprintf(stderr, "cbvh vectors gen: --seed '%s' is not a 64-bit number (decimal, or hex after 0x)\n",
+                        optarg);
                 return 2;
             }
-            sel.seed = (uint64_t)s;
             break;
-        }
         case 'n':
             if (cbvh_parse_long(optarg, CBVH_N_MIN, CBVH_N_MAX, &v)) {
                 fprintf(stderr, "cbvh vectors gen: --bits must be %d..%d, not '%s'\n", CBVH_N_MIN, CBVH_N_MAX, optarg);
@@ -199,17 +261,29 @@ static int cmd_gen(int argc, char **argv) {
     cbvh_vecgen_specs(&sel, specs, n);
 
     char err[1024];
+    /* A malformed MANIFEST stops gen before it writes anything. */
     cbvh_manifest m;
-    int mrc = cbvh_manifest_load(dir, &m, err, sizeof err);
-    if (mrc < 0) {
+    if (cbvh_manifest_load(dir, &m, err, sizeof err) < 0) {
         fprintf(stderr, "cbvh vectors gen: %s (fix or delete it)\n", err);
         free(specs);
         return 2;
     }
-    size_t total = 0, written = 0;
+    cbvh_manifest_free(&m);
+    snprintf(gen_stop_msg, sizeof gen_stop_msg,
+             "cbvh vectors gen: interrupted; the files finished before are listed in %.4000s/MANIFEST\n", dir);
+    /* A signal ignored on entry (a background job of a script) stays ignored. */
+    struct sigaction sa, old_int, old_term;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = gen_on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, NULL, &old_int);
+    sigaction(SIGTERM, NULL, &old_term);
+    if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, NULL);
+    if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, NULL);
+    size_t total = 0;
     int rc = 0;
     for (size_t i = 0; i < n && rc == 0; i++) {
-        char name[256], hex[CBVH_SHA256_HEX_LEN + 1];
+        char name[256];
         cbvh_vecgen_filename(&specs[i], name, sizeof name);
         cbvh_vecfile vf;
         if (cbvh_vecgen_generate(&specs[i], &vf) != 0) {
@@ -217,24 +291,16 @@ static int cmd_gen(int argc, char **argv) {
             rc = 2;
             break;
         }
-        if (write_vecfile(dir, name, &vf, hex, err, sizeof err) != 0 || cbvh_manifest_set(&m, name, hex) != 0) {
+        if (write_vecfile(dir, name, &vf, err, sizeof err) != 0) {
             fprintf(stderr, "cbvh vectors gen: %s\n", err);
             rc = 2;
-        } else {
-            written++;
         }
         total += vf.count;
         cbvh_vecfile_free(&vf);
     }
-    /* The manifest vouches for what was written; entries of other files stay.
-     * Nothing written: the manifest stays as it was (no empty MANIFEST left
-     * behind by a failed first run). */
-    if (written && cbvh_manifest_save(dir, &m, err, sizeof err) != 0) {
-        fprintf(stderr, "cbvh vectors gen: %s\n", err);
-        rc = 2;
-    }
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
     if (rc == 0) printf("wrote %zu files, %zu vectors, to %s (MANIFEST updated)\n", n, total, dir);
-    cbvh_manifest_free(&m);
     free(specs);
     return rc;
 }
@@ -284,7 +350,7 @@ static int cmd_check(int argc, char **argv) {
 
 int cmd_vectors(int argc, char **argv) {
     if (argc < 2) {
-        usage_vectors(stderr);
+        fprintf(stderr, "cbvh vectors: give a subcommand, gen or check (cbvh vectors --help)\n");
         return 2;
     }
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
@@ -293,7 +359,6 @@ int cmd_vectors(int argc, char **argv) {
     }
     if (strcmp(argv[1], "gen") == 0) return cmd_gen(argc - 1, argv + 1);
     if (strcmp(argv[1], "check") == 0) return cmd_check(argc - 1, argv + 1);
-    fprintf(stderr, "cbvh vectors: unknown subcommand '%s' (gen or check)\n", argv[1]);
-    usage_vectors(stderr);
+    fprintf(stderr, "cbvh vectors: unknown subcommand '%s' (gen or check; cbvh vectors --help)\n", argv[1]);
     return 2;
 }

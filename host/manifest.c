@@ -3,9 +3,11 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <openssl/evp.h>
@@ -77,6 +79,11 @@ int cbvh_manifest_parse(const char *buf, size_t len, const char *name, cbvh_mani
         }
         size_t n = (size_t)(nl - s);
         pos += n + 1;
+        if (n && s[n - 1] == '\r') {
+            snprintf(err, errlen, "%s:%zu: line ends in CR (Windows line endings); MANIFEST lines end in \\n only",
+                     name, line);
+            goto bad;
+        }
         int hex_ok = n > CBVH_SHA256_HEX_LEN + 2 && s[CBVH_SHA256_HEX_LEN] == ' ' && s[CBVH_SHA256_HEX_LEN + 1] == ' ';
         for (size_t i = 0; hex_ok && i < CBVH_SHA256_HEX_LEN; i++)
             hex_ok = (s[i] >= '0' && s[i] <= '9') || (s[i] >= 'a' && s[i] <= 'f');
@@ -141,7 +148,9 @@ int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errl
         return -1;
     }
     for (size_t i = 0; i < m->n; i++) fprintf(f, "%s  %s\n", m->e[i].sha256, m->e[i].name);
-    int bad = ferror(f);
+    /* On disk before the rename: a crash must not leave an empty MANIFEST. */
+    int bad = fflush(f) != 0 || fsync(fileno(f)) != 0;
+    bad |= ferror(f);
     bad |= fclose(f) != 0;
     if (bad || rename(tmp, path) != 0) {
         snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
@@ -149,6 +158,50 @@ int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errl
         return -1;
     }
     return 0;
+}
+
+int cbvh_manifest_lock(const char *dir, char *err, size_t errlen) {
+    /* The directory itself is locked, so no lock file is left behind. */
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) {
+        snprintf(err, errlen, "%s: cannot open to lock: %s", dir, strerror(errno));
+        return -1;
+    }
+    int rc;
+    while ((rc = flock(fd, LOCK_EX)) != 0 && errno == EINTR) {
+    }
+    if (rc != 0) {
+        snprintf(err, errlen, "%s: cannot lock: %s", dir, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+void cbvh_manifest_unlock(int fd) {
+    if (fd >= 0) close(fd); /* closing drops the flock */
+}
+
+int cbvh_manifest_is_temp(const char *name) {
+    const char *t = name[0] == '.' ? strstr(name + 1, ".tmp.") : NULL;
+    if (!t || t == name + 1 || !t[5]) return 0;
+    for (t += 5; *t; t++)
+        if (*t < '0' || *t > '9') return 0;
+    return 1;
+}
+
+size_t cbvh_manifest_find_temps(const char *dir, char *first, size_t firstlen) {
+    if (firstlen) first[0] = '\0';
+    DIR *d = opendir(dir);
+    if (!d) return 0;
+    size_t n = 0;
+    struct dirent *de;
+    while ((de = readdir(d)) != NULL) {
+        if (!cbvh_manifest_is_temp(de->d_name)) continue;
+        if (n++ == 0 && firstlen) snprintf(first, firstlen, "%s/%s", dir, de->d_name);
+    }
+    closedir(d);
+    return n;
 }
 
 static int ends_with(const char *s, const char *suffix) {

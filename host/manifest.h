@@ -40,6 +40,21 @@ int cbvh_manifest_set(cbvh_manifest *m, const char *name, const char *sha256);
 /* Writes DIR/MANIFEST sorted by name, through a temp file and rename. */
 int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
 
+/* Exclusive flock(2) on DIR itself, held by `vectors gen` around each
+ * read-merge-write of DIR/MANIFEST (re-read under the lock), so that gens
+ * running in parallel into one directory keep each other's entries.  Blocks
+ * until granted; returns the fd for cbvh_manifest_unlock (which ignores -1),
+ * or -1 with err set. */
+int cbvh_manifest_lock(const char *dir, char *err, size_t errlen);
+void cbvh_manifest_unlock(int fd);
+
+/* Is name a temporary file of gen or cbvh_manifest_save (".NAME.tmp.PID")? */
+int cbvh_manifest_is_temp(const char *name);
+
+/* Counts such temporary files in dir (left by a killed gen); the path of the
+ * first one found goes to first. */
+size_t cbvh_manifest_find_temps(const char *dir, char *first, size_t firstlen);
+
 /* Verifies a directory: DIR/MANIFEST exists and parses, every listed file is
  * present with a matching SHA-256, and no .vec file in DIR is unlisted.
  * On success m holds the manifest (caller frees).  0 or -1 with err set. */

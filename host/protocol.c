@@ -76,6 +76,65 @@ void cbvh_link_flush(cbvh_link *l, int quiet_ms) {
     l->pend_len = 0;
 }
 
+/* Reopens a broken link, trying again after a short, growing pause until the
+ * per-attempt timeout has passed: a board that resets or re-enumerates on USB
+ * is gone for about a second, far longer than one failed open takes. */
+static int reopen_within_timeout(cbvh_link *l, char *why, size_t whylen) {
+    long deadline = now_ms() + l->timeout_ms;
+    long pause_ms = 10;
+    char last[200] = "";
+    for (;;) {
+        if (l->io.reopen(l->io.ctx, last, sizeof last) == 0) return 0;
+        long left = deadline - now_ms();
+        if (left <= 0) break;
+        long nap = pause_ms < left ? pause_ms : left;
+        struct timespec ts = {nap / 1000, (nap % 1000) * 1000000L};
+        nanosleep(&ts, NULL);
+        if (pause_ms < 100) pause_ms *= 2;
+    }
+    snprintf(why, whylen, "link lost and not back within %d ms (%s)", l->timeout_ms, last);
+    return -1;
+}
+
+/* What one attempt received besides its reply: a timeout must say what did
+ * arrive (garbage, another protocol version, a damaged or cut-off frame),
+ * not only that the reply did not. */
+typedef struct {
+    unsigned long bytes, frame_bytes; /* all bytes read; bytes of intact frames among them */
+    uint8_t head[2];                  /* the first two bytes: a reply's magic and version */
+    size_t head_n;
+    unsigned crc_errors, stale_frames;
+} attempt_rx;
+
+static void attempt_rx_add(attempt_rx *a, const uint8_t *buf, long r) {
+    for (long i = 0; i < r && a->head_n < sizeof a->head; i++) a->head[a->head_n++] = buf[i];
+    a->bytes += (unsigned long)r;
+}
+
+static void describe_no_reply(const cbvh_link *l, const attempt_rx *a, char *why, size_t whylen) {
+    size_t partial = l->rx.have; /* bytes of a frame still incomplete */
+    /* Rescans after a damaged frame can re-count bytes: clamp, never wrap. */
+    unsigned long rest = a->bytes > a->frame_bytes ? a->bytes - a->frame_bytes : 0;
+    unsigned long garbage = rest > partial ? rest - partial : 0;
+    if (a->head_n == 2 && a->head[0] == CBVH_FRAME_MAGIC && a->head[1] != CBVH_PROTO_VERSION)
+        snprintf(why, whylen, "reply from protocol version %u (this host speaks version %u)", a->head[1],
+                 CBVH_PROTO_VERSION);
+    else if (a->crc_errors)
+        snprintf(why, whylen, "reply damaged: bad CRC");
+    else if (garbage)
+        snprintf(why, whylen, "%lu bytes that are not a frame arrived instead of a reply", garbage);
+    else if (partial >= CBVH_FRAME_HDR)
+        snprintf(why, whylen, "reply cut short: %zu of its %zu bytes arrived", partial,
+                 (size_t)(CBVH_FRAME_HDR + cbvh_get16(l->rx.buf + 6) + CBVH_FRAME_CRC));
+    else if (partial)
+        snprintf(why, whylen, "reply cut short: %zu bytes of its header arrived", partial);
+    else if (a->stale_frames)
+        snprintf(why, whylen, "no reply within %d ms, only %u stale frame%s (other sequence number or command)",
+                 l->timeout_ms, a->stale_frames, a->stale_frames == 1 ? "" : "s");
+    else
+        snprintf(why, whylen, "no reply within %d ms", l->timeout_ms);
+}
+
 int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16_t len, uint16_t *reply_len,
                        char *err, size_t errlen) {
     if (len > CBVH_FRAME_MAX_PAYLOAD) {
@@ -87,16 +146,12 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
     uint16_t seq = ++l->seq;
     if (len) memcpy(l->tx + CBVH_FRAME_HDR, payload, len);
     size_t n = cbvh_frame_seal(l->tx, cmd, 0, seq, len);
-    char why[200] = "no attempt made";
+    char why[300] = "no attempt made";
     for (int attempt = 0; attempt <= l->max_retries; attempt++) {
         if (attempt) l->st.retries++;
         if (l->broken) {
             if (!l->io.reopen) break; /* nothing can bring the link back */
-            if (l->io.reopen(l->io.ctx, why, sizeof why) != 0) {
-                struct timespec ts = {0, 20 * 1000000L};
-                nanosleep(&ts, NULL);
-                continue;
-            }
+            if (reopen_within_timeout(l, why, sizeof why) != 0) continue;
             l->broken = 0;
             l->st.reopens++;
             cbvh_link_flush(l, 5);
@@ -109,11 +164,12 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
         }
         long deadline = now_ms() + l->timeout_ms;
         int retry_now = 0;
+        attempt_rx got = {0};
         while (!retry_now) {
             long left = deadline - now_ms();
             if (left <= 0) {
                 l->st.timeouts++;
-                snprintf(why, sizeof why, "no reply within %d ms", l->timeout_ms);
+                describe_no_reply(l, &got, why, sizeof why);
                 cbvh_parser_init(&l->rx); /* a partial reply must not glue onto the next */
                 break;
             }
@@ -131,6 +187,7 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
                 l->broken = 1;
                 break;
             }
+            attempt_rx_add(&got, buf, r);
             size_t off = 0;
             while ((off < (size_t)r || cbvh_parser_busy(&l->rx)) && !retry_now) {
                 size_t used = 0;
@@ -139,14 +196,19 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
                 int ev = cbvh_parser_push(&l->rx, buf + off, (size_t)r - off, &used, &f, &e);
                 off += used;
                 if (ev == CBVH_PARSE_ERROR) {
+                    if (e.code == CBVH_E_CRC) got.crc_errors++;
                     if (e.code == CBVH_E_CRC) l->st.crc_errors++;
                     else if (e.code == CBVH_E_SYNC) l->st.sync_errors++;
                     else l->st.other_parse_errors++;
-                    snprintf(why, sizeof why, "reply damaged (%s)", cbvh_error_name(e.code));
-                    if (e.code == CBVH_E_CRC && e.seq_known && e.seq == seq) retry_now = 1;
+                    if (e.code == CBVH_E_CRC && e.seq_known && e.seq == seq) {
+                        snprintf(why, sizeof why, "reply damaged: bad CRC");
+                        retry_now = 1;
+                    }
                 } else if (ev == CBVH_PARSE_FRAME) {
+                    got.frame_bytes += CBVH_FRAME_HDR + f.len + CBVH_FRAME_CRC;
                     if (f.cmd != (cmd | CBVH_REPLY) || f.seq != seq) {
                         l->st.stale_replies++;
+                        got.stale_frames++;
                         continue;
                     }
                     if (f.status != CBVH_E_OK) {
@@ -266,7 +328,7 @@ int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *c
         const uint32_t *src = in + done * (size_t)lay.n_in;
         for (size_t i = 0; i < k * (size_t)lay.n_in; i++) cbvh_put32(payload + RUN_HDR + 4 * i, src[i]);
         uint16_t rlen = 0;
-        char why[256];
+        char why[400];
         if (cbvh_link_transact(l, CBVH_CMD_RUN, payload, (uint16_t)(RUN_HDR + 4 * k * (size_t)lay.n_in), &rlen, why,
                                sizeof why)) {
             snprintf(err, errlen, "%s: vectors %zu..%zu not run: %s", unit->name, done, done + k - 1, why);

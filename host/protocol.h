@@ -42,7 +42,7 @@ typedef struct {
 
 typedef struct {
     cbvh_link_io io;
-    int timeout_ms;  /* per attempt */
+    int timeout_ms;  /* per attempt: for the reply, or for a broken link to reopen */
     int max_retries; /* attempts = 1 + max_retries */
     uint16_t seq;
     int broken;
@@ -67,7 +67,11 @@ void cbvh_link_flush(cbvh_link *l, int quiet_ms);
 
 /* One request/reply exchange with retries.  On success returns 0 and the
  * reply payload is in l->reply[0..*reply_len).  Error replies that are not
- * link errors are final (no retry). */
+ * link errors are final (no retry).  A broken link is reopened, tried again
+ * with a short back-off for up to timeout_ms per attempt (a board reset or
+ * USB re-enumeration takes about a second).  On failure err ends with what
+ * the last attempt saw: nothing, garbage, another protocol version, a frame
+ * cut short or damaged, only stale frames, or a link that did not come back. */
 int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16_t len, uint16_t *reply_len,
                        char *err, size_t errlen);
 

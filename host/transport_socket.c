@@ -56,11 +56,11 @@ static int sock_reopen(void *ctx, char *err, size_t errlen) {
 static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) {
     if (!arg || !*arg) {
         snprintf(err, errlen, "sim backend needs an address: sim:unix:PATH or sim:tcp:HOST:PORT");
-        return CBVH_BACKEND_ERROR;
+        return CBVH_BACKEND_BAD_INPUT;
     }
     /* A wrong address or setting is reported as such, not as "no board
      * (start one with ...)" with a hint that would fail the same way. */
-    if (cbvh_sim_addr_check(arg, err, errlen)) return CBVH_BACKEND_ERROR;
+    if (cbvh_sim_addr_check(arg, err, errlen)) return CBVH_BACKEND_BAD_INPUT;
     sim_state *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
@@ -70,7 +70,7 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
     cbvh_link_init(&s->link, &io);
     if (cbvh_link_env_options(&s->link, err, errlen)) {
         free(s);
-        return CBVH_BACKEND_ERROR;
+        return CBVH_BACKEND_BAD_INPUT;
     }
     snprintf(s->addr, sizeof s->addr, "%s", arg);
     const char *fs = getenv("CBVH_LINK_FAULTS");
@@ -79,19 +79,20 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         if (cbvh_link_fault_parse(&s->env_faults, fs, why, sizeof why)) {
             snprintf(err, errlen, "CBVH_LINK_FAULTS: %s", why);
             free(s);
-            return CBVH_BACKEND_ERROR;
+            return CBVH_BACKEND_BAD_INPUT;
         }
         s->faults = &s->env_faults;
     }
     char why[200];
     s->fd = cbvh_sim_connect(s->addr, why, sizeof why);
     if (s->fd < 0) {
-        if (s->fd == CBVH_SIM_BAD_ADDR) /* e.g. a host name that does not resolve */
+        int bad_addr = s->fd == CBVH_SIM_BAD_ADDR; /* e.g. a host name that does not resolve */
+        if (bad_addr)
             snprintf(err, errlen, "bad board address: %s", why);
         else
             snprintf(err, errlen, "no virtual board: %s (start one with `cbvh board-sim --listen %s`)", why, s->addr);
         free(s);
-        return CBVH_BACKEND_ERROR;
+        return bad_addr ? CBVH_BACKEND_BAD_INPUT : CBVH_BACKEND_NONE;
     }
     cbvh_link_flush(&s->link, 5);
     if (cbvh_link_identify(&s->link, why, sizeof why)) {

@@ -1,5 +1,6 @@
 /* Golden vector files: strict reader and writer (docs/vectors.md). */
 #include "vecfile.h"
+#include "vecgen.h" /* CBVH_VECGEN_VERSION: newer generators are refused */
 
 #include <errno.h>
 #include <inttypes.h>
@@ -64,20 +65,24 @@ static int hexval(char ch) {
     return -1;
 }
 
-/* Strict decimal integer: optional '-', 1..9 digits, nothing else. */
-static int parse_int(const char *s, size_t n, long *v) {
+/* Strict canonical decimal integer: optional '-', digits, nothing else; no
+ * leading zeros, no '+', no "-0", so that each value has one spelling.
+ * 0, INT_BAD (not an integer), INT_NONCANON, or INT_BIG (more than 18 digits). */
+enum { INT_BAD = -1, INT_NONCANON = -2, INT_BIG = -3 };
+static int parse_int(const char *s, size_t n, long long *v) {
     size_t i = 0;
     int neg = 0;
-    if (i < n && s[i] == '-') {
-        neg = 1;
+    if (i < n && (s[i] == '-' || s[i] == '+')) {
+        neg = s[i] == '-';
         i++;
     }
-    if (i == n || n - i > 9) return -1;
-    long x = 0;
-    for (; i < n; i++) {
-        if (s[i] < '0' || s[i] > '9') return -1;
-        x = x * 10 + (s[i] - '0');
-    }
+    if (i == n) return INT_BAD;
+    for (size_t k = i; k < n; k++)
+        if (s[k] < '0' || s[k] > '9') return INT_BAD;
+    if (s[0] == '+' || (s[i] == '0' && (n - i > 1 || neg))) return INT_NONCANON;
+    if (n - i > 18) return INT_BIG;
+    long long x = 0;
+    for (; i < n; i++) x = x * 10 + (s[i] - '0');
     *v = neg ? -x : x;
     return 0;
 }
@@ -135,13 +140,17 @@ static cbvh_vec_status check_fields(const ctx_t *c, const hval *h, const cbvh_la
 }
 
 static cbvh_vec_status need_int(const ctx_t *c, const hval *h, const char *key, long lo, long hi, long *v) {
-    if (parse_int(h->v, h->n, v) != 0) {
-        char shown[200];
-        show(h->v, h->n, shown, sizeof shown);
-        return fail(c, CBVH_VEC_E_HEADER, h->line, "%s: '%s' is not a decimal integer", key, shown);
-    }
-    if (*v < lo || *v > hi)
-        return fail(c, CBVH_VEC_E_PARAM, h->line, "%s %ld out of range [%ld, %ld]", key, *v, lo, hi);
+    long long x = 0;
+    int rc = parse_int(h->v, h->n, &x);
+    char shown[200];
+    show(h->v, h->n, shown, sizeof shown);
+    if (rc == INT_BAD) return fail(c, CBVH_VEC_E_HEADER, h->line, "%s: '%s' is not a decimal integer", key, shown);
+    if (rc == INT_NONCANON)
+        return fail(c, CBVH_VEC_E_HEADER, h->line,
+                    "%s: '%s' is not written canonically (no '+', leading zeros or '-0')", key, shown);
+    if (rc == INT_BIG || x < lo || x > hi)
+        return fail(c, CBVH_VEC_E_PARAM, h->line, "%s %s out of range [%ld, %ld]", key, shown, lo, hi);
+    *v = (long)x;
     return CBVH_VEC_OK;
 }
 
@@ -234,9 +243,16 @@ cbvh_vec_status cbvh_vecfile_parse(const char *buf, size_t len, const char *name
 
     lines L = {buf, len, 0, 0, NULL, 0, 0};
     next_line(&L);
-    if (!L.complete || L.n != strlen(CBVH_VEC_MAGIC) || memcmp(L.s, CBVH_VEC_MAGIC, L.n) != 0) {
+    size_t mn = strlen(CBVH_VEC_MAGIC);
+    if (!L.complete || L.n != mn || memcmp(L.s, CBVH_VEC_MAGIC, L.n) != 0) {
         char shown[200];
         show(L.s, L.n, shown, sizeof shown);
+        /* A cut-off file or Windows line endings, not a foreign file. */
+        if (!L.complete && L.n <= mn && memcmp(L.s, CBVH_VEC_MAGIC, L.n) == 0)
+            return fail(&c, CBVH_VEC_E_HEADER, 1, "first line '%s' is not terminated (file truncated?)", shown);
+        if (L.n == mn + 1 && memcmp(L.s, CBVH_VEC_MAGIC, mn) == 0 && L.s[mn] == '\r')
+            return fail(&c, CBVH_VEC_E_MAGIC, 1,
+                        "first line ends in CR (Windows line endings); vector files use \\n only");
         return fail(&c, CBVH_VEC_E_MAGIC, 1, "not a cbvh vector file: first line is '%s', expected '%s'", shown,
                     CBVH_VEC_MAGIC);
     }
@@ -291,9 +307,14 @@ cbvh_vec_status cbvh_vecfile_parse(const char *buf, size_t len, const char *name
     long v;
     cbvh_vec_status st;
     if (!have[K_FORMAT]) return fail(&c, CBVH_VEC_E_HEADER, sep_line, "missing header key 'format'");
-    if (parse_int(h[K_FORMAT].v, h[K_FORMAT].n, &v) != 0 || v != CBVH_VEC_FORMAT) {
+    long long fmt = 0;
+    int frc = parse_int(h[K_FORMAT].v, h[K_FORMAT].n, &fmt);
+    if (frc != 0 || fmt != CBVH_VEC_FORMAT) {
         char shown[200];
         show(h[K_FORMAT].v, h[K_FORMAT].n, shown, sizeof shown);
+        if (frc == INT_NONCANON)
+            return fail(&c, CBVH_VEC_E_VERSION, h[K_FORMAT].line,
+                        "format: '%s' is not written canonically (no '+', leading zeros or '-0')", shown);
         return fail(&c, CBVH_VEC_E_VERSION, h[K_FORMAT].line, "unsupported format version '%s' (this reader supports %d)",
                     shown, CBVH_VEC_FORMAT);
     }
@@ -340,7 +361,24 @@ cbvh_vec_status cbvh_vecfile_parse(const char *buf, size_t len, const char *name
     }
     long level, gen, count;
     if ((st = need_int(&c, &h[K_LEVEL], "level", 1, 2, &level))) return st;
+    /* The spec names level-2 files *-L2.vec (docs/vectors.md, "Generator"):
+     * a header that disagrees with its name was edited or renamed.  Buffers
+     * without a name have nothing to agree with. */
+    if (name) {
+        const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
+        size_t bn = strlen(base), sn = strlen("-L2.vec");
+        int l2_name = bn >= sn && strcmp(base + bn - sn, "-L2.vec") == 0;
+        if (level == 2 && !l2_name)
+            return fail(&c, CBVH_VEC_E_PARAM, h[K_LEVEL].line, "level 2 but the file name does not end in '-L2.vec'");
+        if (level == 1 && l2_name)
+            return fail(&c, CBVH_VEC_E_PARAM, h[K_LEVEL].line, "level 1 but the file name ends in '-L2.vec' (level 2)");
+    }
     if ((st = need_int(&c, &h[K_GENERATOR], "generator", 1, 999999, &gen))) return st;
+    /* A newer generator may have changed what its vectors mean. */
+    if (gen > CBVH_VECGEN_VERSION)
+        return fail(&c, CBVH_VEC_E_VERSION, h[K_GENERATOR].line,
+                    "generator %ld is newer than this tool's (%d): check it with a newer cbvh", gen,
+                    CBVH_VECGEN_VERSION);
     uint64_t seed;
     if (parse_hex64(h[K_SEED].v, h[K_SEED].n, &seed) != 0) {
         char shown[200];
@@ -348,7 +386,8 @@ cbvh_vec_status cbvh_vecfile_parse(const char *buf, size_t len, const char *name
         return fail(&c, CBVH_VEC_E_HEADER, h[K_SEED].line, "seed '%s' is not 0x followed by 1-16 upper-case hex digits",
                     shown);
     }
-    if ((st = need_int(&c, &h[K_COUNT], "count", 0, (long)CBVH_VEC_MAX_COUNT, &count))) return st;
+    /* At least one vector: an empty file would pass while testing nothing. */
+    if ((st = need_int(&c, &h[K_COUNT], "count", 1, (long)CBVH_VEC_MAX_COUNT, &count))) return st;
 
     cbvh_layout lay;
     unit->layout(&cfg, &lay);

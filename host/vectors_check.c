@@ -14,19 +14,27 @@
 
 /* ---- the work list ---------------------------------------------------------- */
 
+/* Each file with the SHA-256 its MANIFEST gives ("" when there is none): the
+ * bytes that run are hashed again from the same read that is parsed, so a
+ * file rewritten after the manifest check cannot run unverified. */
 typedef struct {
     char **path;
+    char (*sha)[CBVH_SHA256_HEX_LEN + 1];
     size_t n, cap;
 } list_t;
 
-static int list_add(list_t *l, const char *p) {
+static int list_add(list_t *l, const char *p, const char *sha) {
     if (l->n == l->cap) {
         size_t cap = l->cap ? 2 * l->cap : 128;
         char **np = realloc(l->path, cap * sizeof *np);
         if (!np) return -1;
         l->path = np;
+        char(*ns)[CBVH_SHA256_HEX_LEN + 1] = realloc(l->sha, cap * sizeof *ns);
+        if (!ns) return -1;
+        l->sha = ns;
         l->cap = cap;
     }
+    snprintf(l->sha[l->n], sizeof l->sha[l->n], "%s", sha ? sha : "");
     l->path[l->n] = strdup(p);
     return l->path[l->n] ? (int)(l->n++, 0) : -1;
 }
@@ -34,6 +42,7 @@ static int list_add(list_t *l, const char *p) {
 static void list_free(list_t *l) {
     for (size_t i = 0; i < l->n; i++) free(l->path[i]);
     free(l->path);
+    free(l->sha);
 }
 
 static int ends_with(const char *s, const char *suffix) {
@@ -41,8 +50,10 @@ static int ends_with(const char *s, const char *suffix) {
     return n >= k && strcmp(s + n - k, suffix) == 0;
 }
 
-/* A single file: verified against the MANIFEST next to it when there is one. */
-static int verify_single(const char *path, FILE *log, char *err, size_t errlen) {
+/* A single file: verified against the MANIFEST next to it when there is one;
+ * sha receives the listed SHA-256 ("" without a MANIFEST). */
+static int verify_single(const char *path, FILE *log, char *sha, char *err, size_t errlen) {
+    sha[0] = '\0';
     char dir[4096];
     const char *slash = strrchr(path, '/');
     const char *base = slash ? slash + 1 : path;
@@ -83,6 +94,7 @@ static int verify_single(const char *path, FILE *log, char *err, size_t errlen) 
         cbvh_manifest_free(&m);
         return -1;
     }
+    memcpy(sha, e->sha256, CBVH_SHA256_HEX_LEN + 1);
     cbvh_manifest_free(&m);
     return 0;
 }
@@ -100,11 +112,18 @@ static int collect(const char *const *paths, int npaths, FILE *log, list_t *file
             for (size_t k = strlen(d); k > 1 && d[k - 1] == '/'; k--) d[k - 1] = '\0'; /* "vectors/" -> "vectors" */
             cbvh_manifest m;
             if (cbvh_manifest_verify_dir(d, &m, err, errlen) != 0) return -1;
+            /* Leftovers of a killed gen are not vector files: named, not run. */
+            char first[4200];
+            size_t temps = cbvh_manifest_find_temps(d, first, sizeof first);
+            if (temps)
+                fprintf(log,
+                        "cbvh: note: ignoring %zu temporary file%s of an interrupted `vectors gen`, e.g. %s (delete %s)\n",
+                        temps, temps > 1 ? "s" : "", first, temps > 1 ? "them" : "it");
             for (size_t k = 0; k < m.n; k++) {
                 if (!ends_with(m.e[k].name, ".vec")) continue;
                 char p[4096];
                 snprintf(p, sizeof p, "%.3800s/%s", d, m.e[k].name);
-                if (list_add(files, p) != 0) {
+                if (list_add(files, p, m.e[k].sha256) != 0) {
                     cbvh_manifest_free(&m);
                     snprintf(err, errlen, "out of memory");
                     return -1;
@@ -112,8 +131,9 @@ static int collect(const char *const *paths, int npaths, FILE *log, list_t *file
             }
             cbvh_manifest_free(&m);
         } else {
-            if (verify_single(paths[i], log, err, errlen) != 0) return -1;
-            if (list_add(files, paths[i]) != 0) {
+            char sha[CBVH_SHA256_HEX_LEN + 1];
+            if (verify_single(paths[i], log, sha, err, errlen) != 0) return -1;
+            if (list_add(files, paths[i], sha) != 0) {
                 snprintf(err, errlen, "out of memory");
                 return -1;
             }
@@ -124,6 +144,55 @@ static int collect(const char *const *paths, int npaths, FILE *log, list_t *file
         return -1;
     }
     return 0;
+}
+
+/* Reads path once, checks that buffer against sha (when given) and parses
+ * the same buffer: what runs is exactly what was verified. */
+static int load_verified(const char *path, const char *sha, cbvh_vecfile *vf, char *err, size_t errlen) {
+    memset(vf, 0, sizeof *vf);
+    char *buf;
+    size_t len;
+    if (cbvh_read_file(path, &buf, &len, err, errlen) != 0) return -1;
+    if (sha[0]) {
+        char hex[CBVH_SHA256_HEX_LEN + 1];
+        int hrc = cbvh_sha256_hex(buf, len, hex);
+        if (hrc != 0 || strcmp(hex, sha) != 0) {
+            snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path, sha,
+                     hrc ? "?" : hex);
+            free(buf);
+            return -1;
+        }
+    }
+    cbvh_vec_status st = cbvh_vecfile_parse(buf, len, path, vf, err, errlen);
+    free(buf);
+    return st == CBVH_VEC_OK ? 0 : -1;
+}
+
+/* A failed backend call names vectors by their place in the batch (protocol.c:
+ * "unit: vectors A..B not run: ..."); restate them as vectors of the file,
+ * with their lines, as everywhere else.  pick maps run positions to file
+ * vectors under --sample (NULL: the identity). */
+static void locate_failure(const char *berr, const cbvh_vecfile *vf, size_t off, size_t cnt, const size_t *pick,
+                           char *dst, size_t n) {
+    const char *at = strstr(berr, "vectors ");
+    size_t a = 0, b = 0;
+    int len = 0;
+    if (at && sscanf(at, "vectors %zu..%zu%n", &a, &b, &len) == 2 && len > 0 && a <= b && b < cnt) {
+        size_t fa = pick ? pick[off + a] : off + a, fb = pick ? pick[off + b] : off + b;
+        char what[200];
+        if (pick)
+            snprintf(what, sizeof what, "%zu sampled vectors among vectors %zu..%zu (lines %zu..%zu)", b - a + 1, fa,
+                     fb, vf->first_line + fa, vf->first_line + fb);
+        else
+            snprintf(what, sizeof what, "vectors %zu..%zu (lines %zu..%zu)", fa, fb, vf->first_line + fa,
+                     vf->first_line + fb);
+        snprintf(dst, n, "%.*s%s%s", (int)(at - berr), berr, what, at + len);
+        return;
+    }
+    /* Another message: say which batch it was. */
+    size_t fa = pick ? pick[off] : off, fb = pick ? pick[off + cnt - 1] : off + cnt - 1;
+    snprintf(dst, n, "%s (in the batch of vectors %zu..%zu, lines %zu..%zu)", berr, fa, fb, vf->first_line + fa,
+             vf->first_line + fb);
 }
 
 /* ---- reporting -------------------------------------------------------------- */
@@ -214,7 +283,7 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
     memset(&sum, 0, sizeof sum);
     char err[1024] = "";
     int rc = CBVH_CHECK_BAD_INPUT;
-    list_t files = {NULL, 0, 0};
+    list_t files = {NULL, NULL, 0, 0};
     cbvh_backend be;
     memset(&be, 0, sizeof be);
     int be_open = 0;
@@ -243,7 +312,7 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
     for (size_t fi = 0; fi < files.n; fi++) {
         const char *path = files.path[fi];
         cbvh_vecfile vf;
-        if (cbvh_vecfile_load(path, &vf, err, sizeof err) != CBVH_VEC_OK) goto done_json;
+        if (load_verified(path, files.sha[fi], &vf, err, sizeof err) != 0) goto done_json;
         const cbvh_layout *l = &vf.layout;
         size_t need = batch * (size_t)(l->n_out ? l->n_out : 1);
         if (need > act_cap) {
@@ -291,7 +360,9 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
             char berr[512] = "";
             memset(act, 0, cnt * (size_t)l->n_out * sizeof *act);
             if (be.ops->run(&be, vf.unit, &vf.cfg, run_in + off * (size_t)l->n_in, act, cnt, berr, sizeof berr) != 0) {
-                snprintf(err, sizeof err, "%s: backend %s failed: %s", path, be.label, berr);
+                char where[700];
+                locate_failure(berr, &vf, off, cnt, pick, where, sizeof where);
+                snprintf(err, sizeof err, "%s: backend %s failed: %s", path, be.label, where);
                 free(pick);
                 free(picked_in);
                 cbvh_vecfile_free(&vf);
@@ -330,6 +401,12 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
         cbvh_vecfile_free(&vf);
     }
     rc = sum.failed ? CBVH_CHECK_MISMATCH : CBVH_CHECK_PASS;
+    /* A check that ran nothing proves nothing (the reader refuses count 0;
+     * this keeps it so whatever the input). */
+    if (sum.passed + sum.failed == 0) {
+        snprintf(err, sizeof err, "no vectors were run (%zu files)", sum.files);
+        rc = CBVH_CHECK_BAD_INPUT;
+    }
 done_json:
     sum.seconds = now() - t0;
     sum.vectors_per_second = sum.seconds > 0 ? (double)(sum.passed + sum.failed) / sum.seconds : 0;

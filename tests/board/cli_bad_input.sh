@@ -4,7 +4,7 @@
 # part, nothing ignored).  A board-sim that does start (on a private socket)
 # is killed after 5 s, which fails the case.
 # Usage: cli_bad_input.sh PATH/TO/cbvh GROUP VECTOR-DIR
-#   GROUP: listen, rx_idle, faults, env, devices_sim, gateware; VECTOR-DIR: a valid one, so
+#   GROUP: listen, rx_idle, faults, env, devices_sim, gateware, options, backend; VECTOR-DIR: a valid one, so
 #   that `vectors check` gets as far as opening its backend
 set -u
 cbvh=$1
@@ -122,6 +122,37 @@ gateware)
         echo "FAIL: a dying simulation: check exit $rc (want 2), board-sim exit $brc (want 1), board-sim said:"
         sed 's/^/    /' "$tmp/board.err"; fails=$((fails + 1))
     fi
+    ;;
+options)
+    # one line naming the option, not the usage text; bad input is exit 2
+    expect 2 "cbvh board-sim: unknown option '--bogus' (cbvh board-sim --help)" -- board-sim --bogus
+    expect 2 "cbvh board-sim: unknown option 'extra' (cbvh board-sim --help)" -- board-sim extra
+    expect 2 "cbvh board-sim: --listen needs a value (unix:PATH or tcp:HOST:PORT)" -- board-sim --listen
+    expect 2 "cbvh board-sim: --faults needs a value" -- board-sim --listen "unix:$tmp/b.sock" --faults
+    expect 2 "cbvh board-sim: --rx-idle-ms needs a value (an integer in 1..60000)" -- board-sim --rx-idle-ms
+    expect 2 "cbvh board-sim: --break-unit needs a value" -- board-sim --break-unit
+    expect 2 "cbvh board-sim: --gateware needs a value" -- board-sim --gateware
+    # a --gateware that cannot be a simulation is bad input too, not a runtime failure
+    echo "not a program" >"$tmp/plain"
+    expect 2 "cbvh board-sim: --gateware: '$tmp/plain' is neither a vvp script nor executable" \
+        -- board-sim --listen "unix:$tmp/b.sock" --gateware "$tmp/plain"
+    expect 2 "cbvh board-sim: --gateware: '$tmp' is not a file" -- board-sim --listen "unix:$tmp/b.sock" --gateware "$tmp"
+    if "$cbvh" board-sim --help | grep -q "Exit status: 0 .*; 1 .*" && "$cbvh" board-sim --help | grep -q "2 bad options"; then
+        echo "ok: board-sim --help documents its exit statuses"
+    else
+        echo "FAIL: board-sim --help does not document its exit statuses"; fails=$((fails + 1))
+    fi
+    ;;
+backend)
+    expect 2 "backend 'model:xyz': the model backend takes no argument (got 'model:xyz'; use 'model')" \
+        -- vectors check --backend model:xyz "$vec"
+    expect 2 "the model backend takes no argument" -- vectors check --backend model: "$vec"
+    # auto checks CBVH_SIM_ADDR as `cbvh devices` does, before probing anything
+    expect 2 "backend 'auto': CBVH_SIM_ADDR: bad board address 'foo' (expected unix:PATH, tcp:HOST:PORT or a PATH with '/')" \
+        CBVH_SIM_ADDR=foo -- vectors check --backend auto "$vec"
+    expect 2 "CBVH_SIM_ADDR: bad port '99999'" CBVH_SIM_ADDR=tcp:127.0.0.1:99999 -- vectors check "$vec"
+    expect 2 "sim backend at CBVH_SIM_ADDR=unix:$tmp/b.sock: CBVH_LINK_FAULTS: fault spec item 'drop=nan'" \
+        CBVH_SIM_ADDR="unix:$tmp/b.sock" CBVH_LINK_FAULTS=drop=nan -- vectors check "$vec"
     ;;
 *)
     echo "unknown group '$group'"; exit 2 ;;

@@ -261,7 +261,6 @@ static void test_header_rules(void **state) {
         {"min_scale: -30\n", "min_scale: x\n", CBVH_VEC_E_HEADER, "not a decimal integer"},
         {"seed: 0x", "seed: 0y", CBVH_VEC_E_HEADER, "seed '0y"},
         {"level: 1\n", "level: 1\nencoding: modulo\n", CBVH_VEC_E_HEADER, "takes no 'encoding'"},
-        {"count: ", "count: 99999999999", CBVH_VEC_E_HEADER, "not a decimal integer"},
         {"---\n", "--\n", CBVH_VEC_E_HEADER, "malformed header line '--'"},
         {"scale ->", "scale", CBVH_VEC_E_FIELDS, "found 'lb_mod', expected '->'"},
         {" status\n", "\n", CBVH_VEC_E_FIELDS, "fields header ends early: expected 'status'"},
@@ -299,6 +298,88 @@ static void test_header_rules(void **state) {
         free(p);
     }
     free(text);
+}
+
+/* text with the value of header key replaced (the whole line). */
+static char *with_header(const char *text, size_t len, const char *key, const char *value, size_t *n) {
+    char k[64];
+    snprintf(k, sizeof k, "\n%s: ", key);
+    const char *at = strstr(text, k);
+    assert_non_null(at);
+    at += strlen(k);
+    const char *eol = strchr(at, '\n');
+    size_t pre = (size_t)(at - text), vl = strlen(value);
+    *n = len - (size_t)(eol - at) + vl;
+    char *p = malloc(*n);
+    memcpy(p, text, pre);
+    memcpy(p + pre, value, vl);
+    memcpy(p + pre + vl, eol, len - (size_t)(eol - text));
+    return p;
+}
+
+/* Header integers have one spelling; count >= 1; no generator newer than this
+ * tool; the level agrees with the file name; over-long numbers are out of
+ * range, not "not a decimal integer". */
+static void test_header_values(void **state) {
+    (void)state;
+    size_t len;
+    char *text = gen_text("axis_compress", 6, &len); /* count is line 10 */
+    struct {
+        const char *key, *value, *name;
+        cbvh_vec_status st;
+        const char *msg; /* NULL: accepted */
+    } cases[] = {
+        {"count", "0", "mem", CBVH_VEC_E_PARAM, "mem:10: count 0 out of range [1, 100000000]"},
+        {"count", "99999999999", "mem", CBVH_VEC_E_PARAM, "mem:10: count 99999999999 out of range [1, 100000000]"},
+        {"count", "1234567890123456789012", "mem", CBVH_VEC_E_PARAM,
+         "mem:10: count 1234567890123456789012 out of range"},
+        {"count", "02028", "mem", CBVH_VEC_E_HEADER, "mem:10: count: '02028' is not written canonically"},
+        {"count", "+2028", "mem", CBVH_VEC_E_HEADER, "mem:10: count: '+2028' is not written canonically"},
+        {"count", "-", "mem", CBVH_VEC_E_HEADER, "mem:10: count: '-' is not a decimal integer"},
+        {"format", "01", "mem", CBVH_VEC_E_VERSION, "mem:3: format: '01' is not written canonically"},
+        {"format", "+1", "mem", CBVH_VEC_E_VERSION, "mem:3: format: '+1' is not written canonically"},
+        {"quant_bits", "06", "mem", CBVH_VEC_E_HEADER, "mem:4: quant_bits: '06' is not written canonically"},
+        {"min_scale", "-030", "mem", CBVH_VEC_E_HEADER, "mem:5: min_scale: '-030' is not written canonically"},
+        {"min_scale", "-0", "mem", CBVH_VEC_E_HEADER, "mem:5: min_scale: '-0' is not written canonically"},
+        {"level", "01", "mem", CBVH_VEC_E_HEADER, "mem:6: level: '01' is not written canonically"},
+        {"generator", "99", "mem", CBVH_VEC_E_VERSION, "mem:8: generator 99 is newer than this tool's"},
+        {"generator", "007", "mem", CBVH_VEC_E_HEADER, "mem:8: generator: '007' is not written canonically"},
+        {"level", "2", "mem", CBVH_VEC_E_PARAM, "mem:6: level 2 but the file name does not end in '-L2.vec'"},
+        {"level", "2", "d/x.vec", CBVH_VEC_E_PARAM, "d/x.vec:6: level 2 but the file name does not end in '-L2.vec'"},
+        {"level", "1", "d/x-L2.vec", CBVH_VEC_E_PARAM, "d/x-L2.vec:6: level 1 but the file name ends in '-L2.vec'"},
+        {"level", "2", "d/x-L2.vec", CBVH_VEC_OK, NULL},
+        {"min_scale", "0", "mem", CBVH_VEC_OK, NULL},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        size_t n;
+        char *p = with_header(text, len, cases[i].key, cases[i].value, &n);
+        cbvh_vecfile vf;
+        cbvh_vec_status st = cbvh_vecfile_parse(p, n, cases[i].name, &vf, err, sizeof err);
+        cbvh_vecfile_free(&vf);
+        if (st != cases[i].st || (cases[i].msg && strncmp(err, cases[i].msg, strlen(cases[i].msg)) != 0))
+            fail_msg("%s: %s: status %d '%s', want %d with '%s'", cases[i].key, cases[i].value, st, err, cases[i].st,
+                     cases[i].msg ? cases[i].msg : "");
+        assert_null(strchr(err, '\n'));
+        free(p);
+    }
+    free(text);
+}
+
+/* A file cut off right after its first line's text is truncated, not foreign;
+ * a CRLF first line says so. */
+static void test_first_line_messages(void **state) {
+    (void)state;
+    const char *magic = CBVH_VEC_MAGIC;
+    assert_int_equal(parse(magic, strlen(magic)), CBVH_VEC_E_HEADER);
+    assert_string_equal(err, "mem:1: first line '# cbvh golden vectors' is not terminated (file truncated?)");
+    assert_int_equal(parse(magic, 6), CBVH_VEC_E_HEADER);
+    assert_non_null(strstr(err, "mem:1: first line '# cbvh' is not terminated"));
+    const char crlf[] = CBVH_VEC_MAGIC "\r\nunit: ray_box\r\n";
+    assert_int_equal(parse(crlf, sizeof crlf - 1), CBVH_VEC_E_MAGIC);
+    assert_non_null(strstr(err, "mem:1: first line ends in CR (Windows line endings)"));
+    const char other[] = "# cbvh golden vectorz";
+    assert_int_equal(parse(other, sizeof other - 1), CBVH_VEC_E_MAGIC);
+    assert_non_null(strstr(err, "not a cbvh vector file"));
 }
 
 /* ---- MANIFEST and check on a scratch directory ---------------------------- */
@@ -484,6 +565,105 @@ static void test_check_mismatch(void **state) {
     remove_dir();
 }
 
+/* A MANIFEST with CRLF line endings says so (it said "bad file name"). */
+static void test_manifest_crlf(void **state) {
+    (void)state;
+    char text[200];
+    snprintf(text, sizeof text, "%064d  a.vec\r\n", 0);
+    cbvh_manifest m;
+    assert_int_equal(cbvh_manifest_parse(text, strlen(text), "MANIFEST", &m, err, sizeof err), -1);
+    assert_string_equal(err, "MANIFEST:1: line ends in CR (Windows line endings); MANIFEST lines end in \\n only");
+    assert_int_equal(m.n, 0);
+}
+
+/* gen's temporary files (".NAME.tmp.PID") and nothing else. */
+static void test_temp_names(void **state) {
+    (void)state;
+    assert_true(cbvh_manifest_is_temp(".ray_box-N6-ms-30.vec.tmp.4711"));
+    assert_true(cbvh_manifest_is_temp(".MANIFEST.tmp.1"));
+    const char *no[] = {"ray_box-N6-ms-30.vec", ".vec.tmp.", ".a.vec.tmp.", ".a.vec.tmp.12x",
+                        "a.vec.tmp.1",          "..tmp.1",   "."};
+    for (size_t i = 0; i < sizeof no / sizeof no[0]; i++)
+        if (cbvh_manifest_is_temp(no[i])) fail_msg("'%s' taken for a temporary file", no[i]);
+}
+
+/* A stdio stream for o.log that rewrites dir/x.vec the moment the check
+ * writes its first note (auto's "no board found", after the MANIFEST check and
+ * before any vector runs): the rewritten bytes must not run unverified. */
+static char rewrite_path[600];
+static const char *rewrite_text;
+static size_t rewrite_len;
+static char *log_copy;
+static size_t log_copy_len;
+
+static ssize_t rewriting_log(void *cookie, const char *buf, size_t n) {
+    (void)cookie;
+    if (rewrite_text) {
+        FILE *f = fopen(rewrite_path, "wb");
+        if (f) {
+            fwrite(rewrite_text, 1, rewrite_len, f);
+            fclose(f);
+        }
+        rewrite_text = NULL;
+    }
+    char *nl = realloc(log_copy, log_copy_len + n + 1);
+    if (!nl) return -1;
+    log_copy = nl;
+    memcpy(log_copy + log_copy_len, buf, n);
+    log_copy_len += n;
+    log_copy[log_copy_len] = '\0';
+    return (ssize_t)n;
+}
+
+static void test_check_file_rewritten_after_verify(void **state) {
+    (void)state;
+    setenv("CBVH_USB_VID", "f0f0", 1); /* no such board: auto writes its note */
+    setenv("CBVH_USB_PID", "0f0f", 1);
+    size_t len;
+    char *text = gen_text("scale_estimate", 5, &len);
+    /* The same file with vector 0's status flipped: a mismatch if it ran. */
+    char *evil = malloc(len);
+    memcpy(evil, text, len);
+    char *v0 = strstr(evil, "---\n") + 4;
+    char *eol = strchr(v0, '\n');
+    eol[-2] = eol[-2] == '4' ? '0' : '4';
+    for (int single = 0; single < 2; single++) {
+        make_dir_with("scale_estimate", 5, "x.vec");
+        snprintf(rewrite_path, sizeof rewrite_path, "%s/x.vec", dir);
+        rewrite_text = evil;
+        rewrite_len = len;
+        log_copy = NULL;
+        log_copy_len = 0;
+        cookie_io_functions_t io = {NULL, rewriting_log, NULL, NULL};
+        FILE *logf = fopencookie(NULL, "w", io);
+        assert_non_null(logf);
+        setvbuf(logf, NULL, _IONBF, 0);
+        char *out = NULL;
+        size_t ol;
+        FILE *fo = open_memstream(&out, &ol);
+        cbvh_check_opts o;
+        memset(&o, 0, sizeof o);
+        o.backend = "auto";
+        o.max_errors = 20;
+        o.out = fo;
+        o.log = logf;
+        const char *paths[1] = {single ? rewrite_path : dir};
+        int rc = cbvh_vectors_check(paths, 1, &o);
+        fclose(fo);
+        fclose(logf);
+        assert_null(rewrite_text); /* the hook did run */
+        if (rc != CBVH_CHECK_BAD_INPUT || !strstr(log_copy, "x.vec: SHA-256 mismatch: MANIFEST says "))
+            fail_msg("%s: rewritten file: exit %d, log '%s', out '%s'", single ? "file" : "dir", rc, log_copy, out);
+        assert_null(strstr(out, "passed"));
+        free(out);
+        free(log_copy);
+        log_copy = NULL;
+        remove_dir();
+    }
+    free(evil);
+    free(text);
+}
+
 /* auto: no board here, so one line on the log and the model runs. */
 static void test_auto_falls_back(void **state) {
     (void)state;
@@ -524,12 +704,17 @@ int main(void) {
         cmocka_unit_test(test_random_damage),
         cmocka_unit_test(test_roundtrip),
         cmocka_unit_test(test_header_rules),
+        cmocka_unit_test(test_header_values),
+        cmocka_unit_test(test_first_line_messages),
         cmocka_unit_test(test_sha256_known),
         cmocka_unit_test(test_manifest_ok_then_tampered),
         cmocka_unit_test(test_manifest_missing_and_unlisted),
         cmocka_unit_test(test_check_bad_vector_file),
         cmocka_unit_test(test_check_mismatch),
         cmocka_unit_test(test_auto_falls_back),
+        cmocka_unit_test(test_manifest_crlf),
+        cmocka_unit_test(test_temp_names),
+        cmocka_unit_test(test_check_file_rewritten_after_verify),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -29,18 +29,29 @@ cbvh_unit_config cbvh_regmap_config(uint32_t config_word);
  * simulated by Icarus (program built by gateware/scripts/build-board-sim),
  * driven over SPI byte by byte.  broken_unit as in cbvh_regmap_model. */
 typedef struct cbvh_gateware cbvh_gateware;
+/* Whether program can be a simulation at all (a readable file, and a vvp
+ * script or executable): 0, or -1 with err naming the problem. */
+int cbvh_gateware_check(const char *program, char *err, size_t errlen);
 cbvh_gateware *cbvh_gateware_start(const char *program, int broken_unit, char *err, size_t errlen);
 uint32_t cbvh_gateware_read(void *ctx, uint32_t addr);
 void cbvh_gateware_write(void *ctx, uint32_t addr, uint32_t value);
 /* The first failure of the simulation (it ended, hung, answered garbage), or NULL. */
 const char *cbvh_gateware_error(const cbvh_gateware *g);
 uint64_t cbvh_gateware_transactions(const cbvh_gateware *g);
+/* While *stop is zero a transaction waits up to 30 s for the simulation; once
+ * it is not, the transaction in progress is abandoned within 50 ms (an
+ * error, cbvh_gateware_error) and cbvh_gateware_stop kills the simulation
+ * without waiting.  cbvh_sim_board_serve sets it to its opts' stop. */
+void cbvh_gateware_watch_stop(cbvh_gateware *g, volatile int *stop);
 void cbvh_gateware_stop(cbvh_gateware *g);
 
 /* Board addresses: "unix:PATH", "tcp:HOST:PORT" (PORT 1..65535), or a bare
  * PATH (contains '/').  Returns a connected/listening fd, or with err set
  * CBVH_SIM_BAD_ADDR when the address itself is wrong (syntax, port range, no
- * such host) and -1 on any other failure. */
+ * such host) and -1 on any other failure.  Listening on a unix PATH that is
+ * a socket nobody accepts on (left by a crashed board) replaces it; one a
+ * board is listening on fails with "another board is already listening on
+ * PATH". */
 #define CBVH_SIM_BAD_ADDR (-2)
 int cbvh_sim_listen(const char *addr, char *err, size_t errlen);
 int cbvh_sim_connect(const char *addr, char *err, size_t errlen);
@@ -61,7 +72,8 @@ typedef struct {
 
 /* Accepts one connection at a time and runs the firmware core on it until
  * *stop.  Returns 0, or -1 on a listening-socket error or a failed gateware
- * simulation (cbvh_gateware_error says why). */
+ * simulation, including a transaction abandoned by *stop (cbvh_gateware_error
+ * says why). */
 int cbvh_sim_board_serve(const cbvh_sim_board_opts *o);
 
 #endif

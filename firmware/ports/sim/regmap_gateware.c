@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -23,6 +24,8 @@
 /* A ray-box test with its STATUS polls is a few hundred microseconds of
  * simulated time; a reply this late means the simulation hangs. */
 #define REPLY_TIMEOUT_MS 30000
+/* How often a wait for the simulation looks at the stop flag (SIGINT/SIGTERM). */
+#define STOP_CHECK_MS 50
 
 struct cbvh_gateware {
     pid_t pid;
@@ -33,6 +36,8 @@ struct cbvh_gateware {
     uint32_t unit_sel;
     int broken_unit;
     uint64_t transactions;
+    volatile int *stop; /* non-zero: abandon the transaction in progress */
+    int abandoned;      /* a transaction was cut short: the simulation is in an unknown state */
 };
 
 static void fail(cbvh_gateware *g, const char *fmt, ...) {
@@ -44,6 +49,38 @@ static void fail(cbvh_gateware *g, const char *fmt, ...) {
 }
 
 const char *cbvh_gateware_error(const cbvh_gateware *g) { return g->err[0] ? g->err : NULL; }
+
+/* An Icarus program is a vvp script ("#! /usr/bin/vvp"), run by vvp -n (a
+ * signal then finishes it instead of opening its prompt); anything else, e.g.
+ * a Verilator --binary build, runs as it is. */
+static int is_vvp_script(const char *program) {
+    char head[64] = {0};
+    FILE *pf = fopen(program, "r");
+    if (pf) {
+        if (!fgets(head, sizeof head, pf)) head[0] = 0;
+        fclose(pf);
+    }
+    return strncmp(head, "#!", 2) == 0 && strstr(head, "vvp") != NULL;
+}
+
+int cbvh_gateware_check(const char *program, char *err, size_t errlen) {
+    struct stat st;
+    if (access(program, R_OK) != 0 || stat(program, &st) != 0) {
+        snprintf(err, errlen, "cannot read '%s': %s (build it with gateware/scripts/build-board-sim)", program,
+                 strerror(errno));
+        return -1;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "'%s' is not a file (build one with gateware/scripts/build-board-sim)", program);
+        return -1;
+    }
+    if (!is_vvp_script(program) && access(program, X_OK) != 0) {
+        snprintf(err, errlen, "'%s' is neither a vvp script nor executable (build one with "
+                              "gateware/scripts/build-board-sim)", program);
+        return -1;
+    }
+    return 0;
+}
 
 cbvh_gateware *cbvh_gateware_start(const char *program, int broken_unit, char *err, size_t errlen) {
     int in_pipe[2], out_pipe[2];
@@ -65,16 +102,7 @@ cbvh_gateware *cbvh_gateware_start(const char *program, int broken_unit, char *e
         for (int i = 0; i < 2; i++) close(in_pipe[i]), close(out_pipe[i]);
         return NULL;
     }
-    /* An Icarus program is a vvp script ("#! /usr/bin/vvp"), run by vvp -n
-     * (a signal then finishes it instead of opening its prompt); anything
-     * else, e.g. a Verilator --binary build, runs as it is. */
-    char head[64] = {0};
-    FILE *pf = fopen(program, "r");
-    if (pf) {
-        if (!fgets(head, sizeof head, pf)) head[0] = 0;
-        fclose(pf);
-    }
-    int is_vvp = strncmp(head, "#!", 2) == 0 && strstr(head, "vvp") != NULL;
+    int is_vvp = is_vvp_script(program);
     pid_t pid = fork();
     if (pid == 0) {
         setpgid(0, 0); /* the terminal's Ctrl-C stops board-sim, which stops the simulation */
@@ -169,13 +197,19 @@ static int read_reply(cbvh_gateware *g, char *line, size_t cap) {
             fail(g, "gateware simulation: output line too long");
             return -1;
         }
+        if (g->stop && *g->stop) {
+            g->abandoned = 1;
+            fail(g, "stopped by a signal while waiting for the gateware simulation to answer an SPI transaction "
+                    "(transaction abandoned)");
+            return -1;
+        }
         long long left = deadline - now_ms();
         if (left <= 0) {
             fail(g, "gateware simulation did not answer an SPI transaction within %d s", REPLY_TIMEOUT_MS / 1000);
             return -1;
         }
         struct pollfd p = {g->from_sim, POLLIN, 0};
-        int pr = poll(&p, 1, (int)left);
+        int pr = poll(&p, 1, (int)(left < STOP_CHECK_MS ? left : STOP_CHECK_MS));
         if (pr < 0 && errno == EINTR) continue;
         if (pr <= 0) continue;
         ssize_t n = read(g->from_sim, g->buf + g->have, sizeof g->buf - g->have);
@@ -249,6 +283,8 @@ void cbvh_gateware_write(void *ctx, uint32_t addr, uint32_t value) {
 
 uint64_t cbvh_gateware_transactions(const cbvh_gateware *g) { return g->transactions; }
 
+void cbvh_gateware_watch_stop(cbvh_gateware *g, volatile int *stop) { g->stop = stop; }
+
 void cbvh_gateware_stop(cbvh_gateware *g) {
     if (!g) return;
     if (g->pid > 0) {
@@ -260,11 +296,13 @@ void cbvh_gateware_stop(cbvh_gateware *g) {
     close(g->from_sim);
     if (g->pid > 0) {
         int st, reaped = 0;
-        for (int i = 0; i < 100 && !reaped; i++) {
+        /* A simulation stuck in a transaction is not given its second. */
+        for (int i = 0; i < 100 && !reaped && !g->abandoned; i++) {
             reaped = waitpid(g->pid, &st, WNOHANG) == g->pid;
             if (!reaped) usleep(10000);
         }
         if (!reaped) {
+            kill(-g->pid, SIGKILL); /* its process group (setpgid above): a wrapper's children too */
             kill(g->pid, SIGKILL);
             waitpid(g->pid, &st, 0);
         }

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
@@ -62,6 +63,39 @@ int cbvh_sim_addr_check(const char *addr, char *err, size_t errlen) {
     return parse_addr(addr, &a, err, errlen);
 }
 
+/* A unix socket path that bind() finds taken: a board left behind by a crash
+ * (SIGKILL leaves the file; nobody accepts on it) or a live one.  Returns 1
+ * when the stale file was removed and bind may be tried again, else 0 with
+ * err saying why the path cannot be used. */
+static int clear_stale_socket(const struct sockaddr_un *sa, char *err, size_t errlen) {
+    struct stat st;
+    if (lstat(sa->sun_path, &st) != 0 || !S_ISSOCK(st.st_mode)) {
+        snprintf(err, errlen, "listen on %s: the path exists and is not a socket", sa->sun_path);
+        return 0;
+    }
+    int probe = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0); /* a full backlog must not block */
+    if (probe < 0) {
+        snprintf(err, errlen, "socket: %s", strerror(errno));
+        return 0;
+    }
+    int live = connect(probe, (const struct sockaddr *)sa, sizeof *sa) == 0;
+    int why = errno;
+    close(probe);
+    if (live) {
+        snprintf(err, errlen, "another board is already listening on %s", sa->sun_path);
+        return 0;
+    }
+    if (why != ECONNREFUSED) { /* e.g. a full backlog: someone may be there */
+        snprintf(err, errlen, "listen on %s: address in use and not answering (%s)", sa->sun_path, strerror(why));
+        return 0;
+    }
+    if (unlink(sa->sun_path) != 0) {
+        snprintf(err, errlen, "listen on %s: cannot remove the stale socket: %s", sa->sun_path, strerror(errno));
+        return 0;
+    }
+    return 1;
+}
+
 static int open_addr(const char *addr, int listening, char *err, size_t errlen) {
     sim_addr a;
     if (parse_addr(addr, &a, err, errlen)) return CBVH_SIM_BAD_ADDR;
@@ -75,6 +109,13 @@ static int open_addr(const char *addr, int listening, char *err, size_t errlen) 
         sa.sun_family = AF_UNIX;
         strcpy(sa.sun_path, a.path);
         int rc = listening ? bind(fd, (struct sockaddr *)&sa, sizeof sa) : connect(fd, (struct sockaddr *)&sa, sizeof sa);
+        if (rc != 0 && listening && errno == EADDRINUSE) {
+            if (!clear_stale_socket(&sa, err, errlen)) {
+                close(fd);
+                return -1;
+            }
+            rc = bind(fd, (struct sockaddr *)&sa, sizeof sa);
+        }
         if (rc == 0 && listening) rc = listen(fd, 4);
         if (rc != 0) {
             snprintf(err, errlen, "%s %s: %s", listening ? "listen on" : "connect to", a.path, strerror(errno));
@@ -160,6 +201,7 @@ int cbvh_sim_board_serve(const cbvh_sim_board_opts *o) {
     cbvh_regmap_model_init(&board->regs);
     board->regs.broken_unit = o->broken_unit;
     board->gateware = o->gateware;
+    if (o->gateware) cbvh_gateware_watch_stop(o->gateware, o->stop);
     cbvh_fw_hal hal = {board, hal_read, hal_write, hal_send, "cbvh-sim"};
     cbvh_fw_init(fw, &hal);
     int rc = 0;
@@ -204,6 +246,9 @@ int cbvh_sim_board_serve(const cbvh_sim_board_opts *o) {
         if (o->verbose) fprintf(stderr, "cbvh board-sim: host disconnected\n");
         if (rc) break;
     }
+    /* A stop that abandoned a gateware transaction (even the reset at start)
+     * is a failure, not a clean stop. */
+    if (board->gateware && cbvh_gateware_error(board->gateware)) rc = -1;
     free(board);
     free(fw);
     return rc;
