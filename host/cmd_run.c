@@ -5,25 +5,58 @@
  *      bit-exact CBVH at N = 3..10, and report memory, traversal work, the timing
  *      model's time and CPU time relative to the float BVH, with a proof that
  *      every CBVH gives exactly the float BVH's hits. */
+#include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
+#include <sys/stat.h>
 
 #include <cjson/cJSON.h>
 
+#include "cbvh/oom.h"
+#include "cbvh_sim.h"
 #include "commands.h"
 #include "effects.h"
 #include "scene_file.h"
 #include "timing_model.h"
 #include "vectors_check.h"
 
-/* A bundled resource: relative to the working directory, else to the source tree. */
-static const char *bundled(const char *rel, char *buf, size_t len) {
-    if (access(rel, R_OK) == 0) return rel;
-    snprintf(buf, len, "%s/%s", CBVH_SOURCE_DIR, rel);
-    return buf;
+/* The defaults are the source tree's committed vectors and bundled scene
+ * wherever cbvh runs: a ./vectors or ./scenes of the working directory is
+ * not what the help promises.  Explicit paths stay relative to the cwd. */
+#define DEFAULT_VECTORS CBVH_SOURCE_DIR "/vectors"
+#define DEFAULT_SCENE CBVH_SOURCE_DIR "/scenes/bunny.scene"
+
+/* --backend's form (the names of backend.c, a sim address's syntax), checked
+ * before anything is printed; opening it is left to the vector check.  0, or
+ * -1 with err set as the check would word it. */
+static int check_backend_spec(const char *spec, char *err, size_t errlen) {
+    size_t n = strcspn(spec, ":");
+    const char *arg = spec[n] == ':' ? spec + n + 1 : NULL;
+    static const char *const names[] = {"model", "usb", "hid", "sim"};
+    int known = strcmp(spec, "auto") == 0;
+    for (size_t i = 0; !known && i < sizeof names / sizeof names[0]; i++)
+        known = strlen(names[i]) == n && strncmp(names[i], spec, n) == 0;
+    int sim = known && n == 3 && strncmp(spec, "sim", 3) == 0;
+    char why[400];
+    if (!known)
+        snprintf(why, sizeof why, "unknown backend '%.100s' (expected auto, model, usb, hid or sim:ADDR)", spec);
+    else if (sim && (!arg || !*arg))
+        snprintf(why, sizeof why, "sim backend needs an address: sim:unix:PATH or sim:tcp:HOST:PORT");
+    else if (!sim || cbvh_sim_addr_check(arg, why, sizeof why) == 0)
+        return 0;
+    snprintf(err, errlen, "backend '%.100s': %s", spec, why);
+    return -1;
+}
+
+/* " x1.234"; where the float BVH's value is 0: " -" if this one's is too (0/0
+ * is no ratio), " x inf" if not (as cbvh trace and sweep print them). */
+static void print_x(double a, double b, int prec) {
+    if (b > 0)
+        printf(" x%.*f", prec, a / b);
+    else
+        printf(" %*s", prec + 3, a > 0 ? "x inf" : "-"); /* as wide as " x1.000" */
 }
 
 static void usage(FILE *f) {
@@ -37,9 +70,10 @@ static void usage(FILE *f) {
             "the float BVH, and whether the hits are identical.\n"
             "\n"
             "  --backend SPEC  auto (default), model, usb, hid, sim:ADDR\n"
-            "  --vectors DIR   vector directory (default: the committed vectors/)\n"
+            "  --vectors DIR   vector directory (default: the committed vectors/ of the source tree,\n"
+            "                  from any working directory)\n"
             "  --scene SCENE   scene file, or a mesh file / proc:NAME with its default scene\n"
-            "                  (default: scenes/bunny.scene; docs/scenes.md)\n"
+            "                  (default: the source tree's scenes/bunny.scene; docs/scenes.md)\n"
             "  --json          one JSON object instead of tables\n");
 }
 
@@ -90,7 +124,7 @@ int cmd_run(int argc, char **argv) {
                                              {0, 0, 0, 0}};
     const char *backend = "auto", *vec_dir = NULL, *scene_path = NULL;
     int json = 0, c;
-    char vbuf[1024], sbuf[1024], err[512];
+    char err[512];
     optind = 1;
     opterr = 0;
     while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -107,11 +141,20 @@ int cmd_run(int argc, char **argv) {
         fprintf(stderr, "cbvh run: unexpected argument '%s'\n", argv[optind]);
         return 2;
     }
-    if (!vec_dir) vec_dir = bundled("vectors", vbuf, sizeof vbuf);
-    if (!scene_path) scene_path = bundled("scenes/bunny.scene", sbuf, sizeof sbuf);
+    if (!vec_dir) vec_dir = DEFAULT_VECTORS;
+    if (!scene_path) scene_path = DEFAULT_SCENE;
+    /* Options first, then the scene (a typo in --scene is reported at once,
+     * not after a whole vector check on a board): nothing is printed before. */
+    struct stat vst;
+    if (check_backend_spec(backend, err, sizeof err)) {
+        fprintf(stderr, "cbvh run: %s\n", err);
+        return 2;
+    }
+    if (stat(vec_dir, &vst) != 0) {
+        fprintf(stderr, "cbvh run: %s: %s\n", vec_dir, strerror(errno));
+        return 2;
+    }
 
-    /* The scene is loaded first: a typo in --scene is reported at once, not
-     * after a whole vector check on a board. */
     cbvh_scene_desc d;
     if (cbvh_scene_file_open(scene_path, &d, err, sizeof err) != 0) {
         fprintf(stderr, "cbvh run: %s\n", err);
@@ -180,7 +223,9 @@ int cmd_run(int argc, char **argv) {
             cJSON_AddItemToArray(arr, r);
         }
         char *text = cJSON_Print(root);
-        printf("%s\n", text);
+        if (!text) cbvh_out_of_memory("run JSON");
+        cbvh_json_fputs_utf8(text, stdout); /* paths may hold bytes that are not UTF-8 */
+        putchar('\n');
         free(text);
         cJSON_Delete(root);
     } else {
@@ -194,10 +239,15 @@ int cmd_run(int argc, char **argv) {
             snprintf(name, sizeof name, w->bits ? "N=%d" : "float", w->bits);
             printf("  %-6s %7llu  %7.2f  %7.2f  %9.0f  %12.1f  %10.2f", name, (unsigned long long)w->node_bytes,
                    w->box, w->tri, w->bytes, w->model_ns, w->cpu_us);
-            if (w->bits)
-                printf("   x%.3f x%.3f x%.3f x%.3f x%.3f x%.2f", (double)w->node_bytes / (double)f->node_bytes,
-                       w->box / f->box, w->tri / f->tri, w->bytes / f->bytes, w->model_ns / f->model_ns,
-                       w->cpu_us / f->cpu_us);
+            if (w->bits) {
+                printf("  ");
+                print_x((double)w->node_bytes, (double)f->node_bytes, 3);
+                print_x(w->box, f->box, 3);
+                print_x(w->tri, f->tri, 3);
+                print_x(w->bytes, f->bytes, 3);
+                print_x(w->model_ns, f->model_ns, 3);
+                print_x(w->cpu_us, f->cpu_us, 2);
+            }
             printf("\n");
         }
         printf("\nHits %s the float BVH's for every width (closest hits: triangle and t bits;\n"

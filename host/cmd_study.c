@@ -1,5 +1,6 @@
 /* cbvh study: the backtracking and memory-traffic study of Viitanen et al.
  * (Table 1 and Fig. 10) on real and procedural scenes.  docs/study.md. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,7 +8,9 @@
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
+#include "cbvh/oom.h"
 #include "commands.h"
+#include "parse_int.h"
 #include "scene_load.h"
 
 #ifndef CBVH_SCENES_DIR
@@ -27,7 +30,9 @@ enum {
 static const char *cfg_name[NCFG] = {"R-", "R2", "R3", "R4", "M-", "M2", "M3", "M4"};
 
 typedef struct {
-    char name[64];
+    char name[64];        /* the table's row: row_name() */
+    char scene_name[64];  /* the loader's name ("proc:cloth" for proc:cloth:4): JSON "name", as before */
+    const char *spec;     /* the argument as given: JSON "spec" */
     uint32_t tris, leaves, pairs;
     double prims_per_leaf, sah_ratio, sah_ratio_sah_builder;
     size_t cbvh_bytes, bvh_bytes;
@@ -55,7 +60,7 @@ static cbvh_bvh bvh_copy(const cbvh_bvh *b) {
     cbvh_bvh c = *b;
     c.nodes = malloc((size_t)b->nnodes * sizeof *b->nodes);
     c.prims = malloc((size_t)b->nprims * sizeof *b->prims);
-    if (!c.nodes || !c.prims) abort();
+    if (!c.nodes || !c.prims) cbvh_out_of_memory("BVH copy");
     memcpy(c.nodes, b->nodes, (size_t)b->nnodes * sizeof *b->nodes);
     memcpy(c.prims, b->prims, (size_t)b->nprims * sizeof *b->prims);
     return c;
@@ -88,11 +93,29 @@ static int run_bu(cbvh_bvh *b, const cbvh_tri *refit, cbvh_params p, uint64_t bt
     return 0;
 }
 
+/* The row's name: a procedural spec as given (proc:cloth:4, not the
+ * loader's proc:cloth), a file by its name. */
+static void row_name(char *out, size_t n, const char *spec, const cbvh_scene *s) {
+    snprintf(out, n, "%s", strncmp(spec, "proc:", 5) == 0 ? spec : s->name);
+}
+
 static int study_scene(const char *spec, cbvh_params p, scene_result *r, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
     cbvh_scene s;
     if (cbvh_scene_open(spec, &s, err, errlen)) return -1;
-    snprintf(r->name, sizeof r->name, "%s", s.name);
+    row_name(r->name, sizeof r->name, spec, &s);
+    snprintf(r->scene_name, sizeof r->scene_name, "%s", s.name);
+    r->spec = spec;
+    /* Every vertex at one point: both SAH costs are 0 and their ratio 0/0;
+     * rejected as trace and sweep reject it. */
+    float lo[3], hi[3];
+    cbvh_scene_bounds(&s, lo, hi);
+    if (!(hi[0] > lo[0] || hi[1] > lo[1] || hi[2] > lo[2])) {
+        snprintf(err, errlen, "%s: the mesh has no extent (every vertex at one point), so no SAH cost to compare",
+                 spec);
+        cbvh_scene_free(&s);
+        return -1;
+    }
     r->tris = s.ntris;
     cbvh_bvh b, sah;
     int rc = -1;
@@ -125,7 +148,7 @@ static int study_scene(const char *spec, cbvh_params p, scene_result *r, char *e
     /* Refit to a deformed frame: the glTF morph animation at half time if the
      * scene has one, else a procedural twist + wave. */
     moved = malloc((size_t)s.ntris * sizeof *moved);
-    if (!moved) abort();
+    if (!moved) cbvh_out_of_memory("refit frame");
     if (s.nmorph && s.nkeys) {
         cbvh_scene_frame(&s, s.key_time[0] + 0.5f * cbvh_scene_duration(&s), moved);
         r->deform = "morph";
@@ -164,7 +187,7 @@ typedef struct {
 static int sweep_scene(const char *spec, int quant_bits, sweep_result *r, char *err, size_t errlen) {
     cbvh_scene s;
     if (cbvh_scene_open(spec, &s, err, errlen)) return -1;
-    snprintf(r->name, sizeof r->name, "%s", s.name);
+    row_name(r->name, sizeof r->name, spec, &s);
     cbvh_bvh b;
     int rc = -1;
     if (cbvh_build_lbvh(&s, &b, err, errlen)) goto out;
@@ -186,18 +209,8 @@ out:
     return rc;
 }
 
-static void json_str(const char *s) {
-    putchar('"');
-    for (; *s; s++) {
-        if (*s == '"' || *s == '\\')
-            printf("\\%c", *s);
-        else if ((unsigned char)*s < 0x20)
-            printf("\\u%04x", *s);
-        else
-            putchar(*s);
-    }
-    putchar('"');
-}
+/* Scene names are file names: any bytes (commands.h). */
+static void json_str(const char *s) { cbvh_json_str(s, stdout); }
 
 static void json_num(double x) {
     if (isnan(x))
@@ -265,7 +278,9 @@ static void usage(FILE *f) {
                "         bunny plus proc:cloth, proc:far, proc:wave.\n"
                "  Prints the Table-1-style study (backtracking, memory traffic of LBVH and refit,\n"
                "  SAH cost, primitives per leaf) and the minimum-scale sweep of Fig. 10 (docs/study.md).\n"
-               "  Exit status: 0 done, 2 bad input (an option, or a scene that cannot be loaded or built).\n");
+               "  --quant-bits N  coordinate bits, %d..%d (default 6); --min-scale E  %d..%d (default %d)\n"
+               "  Exit status: 0 done, 2 bad input (an option, or a scene that cannot be loaded or built).\n",
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
 }
 
 int cmd_study(int argc, char **argv) {
@@ -273,7 +288,7 @@ int cmd_study(int argc, char **argv) {
     const char **specs = malloc((size_t)(argc + 4) * sizeof *specs);
     int ns = 0, json = 0, sweep = 1;
     cbvh_params p = {6, CBVH_MIN_SCALE_DEFAULT};
-    if (!specs) abort();
+    if (!specs) cbvh_out_of_memory("scene list");
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             usage(stdout);
@@ -283,39 +298,44 @@ int cmd_study(int argc, char **argv) {
             json = 1;
         } else if (!strcmp(argv[i], "--no-sweep")) {
             sweep = 0;
-        } else if ((!strcmp(argv[i], "--quant-bits") || !strcmp(argv[i], "--min-scale")) && i + 1 < argc) {
-            char *end;
-            long v = strtol(argv[i + 1], &end, 10);
-            if (*end || argv[i + 1][0] == 0) {
-                fprintf(stderr, "cbvh study: %s needs an integer, got '%s'\n", argv[i], argv[i + 1]);
+        } else if (!strcmp(argv[i], "--quant-bits") || !strcmp(argv[i], "--min-scale")) {
+            /* One line naming the option and the value (not the usage). */
+            int q = argv[i][2] == 'q';
+            long lo = q ? CBVH_N_MIN : CBVH_SCALE_FLOOR, hi = q ? CBVH_N_MAX : CBVH_SCALE_CEIL, v;
+            if (i + 1 >= argc) {
+                fprintf(stderr, "cbvh study: %s needs a value (%ld..%ld)\n", argv[i], lo, hi);
                 free(specs);
                 return 2;
             }
-            if (argv[i][2] == 'q')
+            if (cbvh_parse_long(argv[i + 1], LONG_MIN, LONG_MAX, &v)) {
+                fprintf(stderr, "cbvh study: %s needs an integer in %ld..%ld, got '%s'\n", argv[i], lo, hi,
+                        argv[i + 1]);
+                free(specs);
+                return 2;
+            }
+            if (v < lo || v > hi) {
+                fprintf(stderr, "cbvh study: %s %s out of range %ld..%ld\n", argv[i], argv[i + 1], lo, hi);
+                free(specs);
+                return 2;
+            }
+            if (q)
                 p.quant_bits = (int)v;
             else
                 p.min_scale = (int)v;
             i++;
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "cbvh study: unknown option '%s'\n", argv[i]);
-            usage(stderr);
+            fprintf(stderr, "cbvh study: unknown option '%s' (see cbvh study --help)\n", argv[i]);
             free(specs);
             return 2;
         } else {
             specs[ns++] = argv[i];
         }
     }
-    if (cbvh_params_check(&p)) {
-        fprintf(stderr, "cbvh study: quant bits must be %d..%d and min scale %d..%d\n", CBVH_N_MIN, CBVH_N_MAX,
-                CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL);
-        free(specs);
-        return 2;
-    }
     if (ns == 0)
         for (int i = 0; i < 4; i++) specs[ns++] = defaults[i];
     scene_result *res = calloc((size_t)ns, sizeof *res);
     sweep_result *sw = calloc((size_t)ns, sizeof *sw);
-    if (!res || !sw) abort();
+    if (!res || !sw) cbvh_out_of_memory("study results");
     char err[512];
     int status = 0;
     for (int i = 0; i < ns; i++) {
@@ -334,7 +354,9 @@ int cmd_study(int argc, char **argv) {
         for (int i = 0; i < ns; i++) {
             const scene_result *r = &res[i];
             printf("%s{\"name\":", i ? "," : "");
-            json_str(r->name);
+            json_str(r->scene_name);
+            printf(",\"spec\":");
+            json_str(r->spec);
             printf(",\"triangles\":%u,\"leaves\":%u,\"node_pairs\":%u,\"prims_per_leaf\":", r->tris, r->leaves,
                    r->pairs);
             json_num(r->prims_per_leaf);

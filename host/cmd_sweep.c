@@ -5,6 +5,7 @@
  * differing ray otherwise).  --formats cbvh,qbvh,tlist... adds the QBVH and
  * traversal lists as more rows, checked the same way. */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +14,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "cbvh/oom.h"
 #include "chart_svg.h"
 #include "commands.h"
 #include "image_png.h"
@@ -48,7 +50,12 @@ static void usage(FILE *f) {
             "                    bounding-sphere hierarchy, docs/tlist.md; default 6 lists, earliest first)\n"
             "  --one-sided       triangles count only from their front side (counter-clockwise), on every\n"
             "                    format; needed by tlist:...:cull (back-face culling)\n"
-            "  --json            machine-readable output on stdout\n",
+            "  --json            machine-readable output on stdout\n"
+            "  A list option (--mant, --min-scale, --heatmap, --formats) may be given once; any other\n"
+            "  option given twice: the last wins.\n"
+            "testing:\n"
+            "  --test-corrupt S:R  pretend setting S (index in trace order) returned a wrong answer for\n"
+            "                      ray R, to show the identity check fails (docs/sweep.md)\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
 }
 
@@ -64,6 +71,16 @@ static int is_int(const char *s) {
 static int has_empty_item(const char *s) {
     size_t n = strlen(s);
     return n == 0 || s[0] == ',' || s[n - 1] == ',' || strstr(s, ",,") != NULL;
+}
+
+/* A list option given a second time: an error, not "the last wins" (that
+ * silently dropped the first values; --mant 8 --mant 24 looks like two). */
+static int list_again(const char *opt, int *given) {
+    if ((*given)++) {
+        fprintf(stderr, "cbvh sweep: %s given twice (all its values go after one %s)\n", opt, opt);
+        return -1;
+    }
+    return 0;
 }
 
 /* Values after a list option: the following arguments that are integers
@@ -180,7 +197,9 @@ static void default_out(const char *scene, char *out, size_t n) {
     snprintf(out, n, "sweep-%.*s", (int)len, b);
 }
 
-static double rel(double a, double b) { return b > 0 ? a / b : (a > 0 ? 1e300 : 1); }
+/* a relative to the float BVH's b.  The float BVH did none (b = 0): NaN when
+ * neither did (0/0 is no ratio, not 1), infinity when only a did some. */
+static double rel(double a, double b) { return b > 0 ? a / b : a > 0 ? INFINITY : NAN; }
 
 static const char *metric_names[SWEEP_NMETRICS] = {"box tests", "triangle tests", "bytes", "modelled time",
                                                   "CPU time"};
@@ -188,10 +207,30 @@ static const char *metric_keys[SWEEP_NMETRICS] = {"box_per_ray", "tri_per_ray", 
                                                  "cpu_us_per_ray"};
 
 static void print_rel(double r) {
-    if (r >= 1e299)
+    if (isnan(r))
+        printf(" %7s", "-");
+    else if (isinf(r))
         printf(" %7s", "inf");
     else
         printf(" %7.3f", r);
+}
+
+/* " x1.234", or " -" / " x inf" where the float BVH did none. */
+static void print_x(double r) {
+    if (isnan(r))
+        printf(" -");
+    else if (isinf(r))
+        printf(" x inf");
+    else
+        printf(" x%.3f", r);
+}
+
+/* JSON has no NaN or infinity: a ratio without a finite value is null. */
+static void json_rel(cJSON *o, const char *key, double r) {
+    if (isfinite(r))
+        cJSON_AddNumberToObject(o, key, r);
+    else
+        cJSON_AddNullToObject(o, key);
 }
 
 static void text_row(const char *setting, const char *effect, const cbvh_fx_stats *s, const cbvh_fx_stats *f,
@@ -222,11 +261,8 @@ static cJSON *json_costs(const cbvh_fx_stats *s, const cbvh_fx_stats *f, uint64_
     for (int m = 0; m < SWEEP_NMETRICS; m++) cJSON_AddNumberToObject(o, metric_keys[m], p[m]);
     cJSON *r = cJSON_AddObjectToObject(o, "relative_to_float");
     static const char *rk[SWEEP_NMETRICS] = {"box_tests", "tri_tests", "bytes", "model_time", "cpu_time"};
-    for (int m = 0; m < SWEEP_NMETRICS; m++) {
-        double v = rel(p[m], q[m]);
-        cJSON_AddNumberToObject(r, rk[m], v >= 1e299 ? -1 : v);
-    }
-    cJSON_AddNumberToObject(r, "node_memory", rel((double)mem, (double)fmem));
+    for (int m = 0; m < SWEEP_NMETRICS; m++) json_rel(r, rk[m], rel(p[m], q[m]));
+    json_rel(r, "node_memory", rel((double)mem, (double)fmem));
     return o;
 }
 
@@ -260,10 +296,29 @@ static int ensure_dir(const char *dir) {
     return 0;
 }
 
+/* --out must take files before the sweep runs, not fail after it: create and
+ * remove a temporary file there (access(W_OK) would pass for root on a
+ * read-only directory and says nothing about a read-only file system). */
+static int check_writable(const char *dir) {
+    char tmp[1100];
+    if (snprintf(tmp, sizeof tmp, "%s/.cbvh-sweep-XXXXXX", dir) >= (int)sizeof tmp) {
+        fprintf(stderr, "cbvh sweep: --out %s: path too long\n", dir);
+        return -1;
+    }
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        fprintf(stderr, "cbvh sweep: --out %s: cannot write files there: %s\n", dir, strerror(errno));
+        return -1;
+    }
+    close(fd);
+    unlink(tmp);
+    return 0;
+}
+
 int cmd_sweep(int argc, char **argv) {
     const char *scene = NULL, *outdir = NULL;
     cbvh_sweep_opts o = {.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1};
-    int json = 0, nheat = 0, heat_given = 0;
+    int json = 0, nheat = 0, heat_given = 0, mant_given = 0, ms_given = 0, formats_given = 0;
     long knee_pct = 10;
     heat_spec heat[MAX_HEAT];
     const char *corrupt = NULL;
@@ -297,9 +352,11 @@ int cmd_sweep(int argc, char **argv) {
             o.bits_lo = (int)lo;
             o.bits_hi = (int)hi;
         } else if (strcmp(a, "--mant") == 0) {
+            if (list_again(a, &mant_given)) return 2;
             if ((o.nmant = parse_list(a, argc, argv, &i, CBVH_MANT_MIN, CBVH_MANT_MAX, o.mant, CBVH_SWEEP_MAX_LIST)) < 0)
                 return 2;
         } else if (strcmp(a, "--min-scale") == 0) {
+            if (list_again(a, &ms_given)) return 2;
             if ((o.nmin_scale = parse_list(a, argc, argv, &i, -126, 126, o.min_scale, CBVH_SWEEP_MAX_LIST)) < 0)
                 return 2;
         } else if (strcmp(a, "--spp") == 0) {
@@ -325,7 +382,7 @@ int cmd_sweep(int argc, char **argv) {
             }
             outdir = argv[++i];
         } else if (strcmp(a, "--heatmap") == 0) {
-            heat_given = 1;
+            if (list_again(a, &heat_given)) return 2;
             int n0 = nheat;
             while (i + 1 < argc && argv[i + 1][0] != '-' && (strcmp(argv[i + 1], "float") == 0 ||
                                                               strcmp(argv[i + 1], "qbvh") == 0 ||
@@ -351,6 +408,7 @@ int cmd_sweep(int argc, char **argv) {
         } else if (strcmp(a, "--one-sided") == 0)
             o.one_sided = 1;
         else if (strcmp(a, "--formats") == 0) {
+            if (list_again(a, &formats_given)) return 2;
             const char *v = i + 1 < argc ? argv[++i] : "";
             char buf[512], ferr[200] = "";
             size_t len = strlen(v);
@@ -448,6 +506,23 @@ int cmd_sweep(int argc, char **argv) {
             return 2;
         }
     }
+    /* The same map twice (also "6" and "6:24:-30") would be drawn twice. */
+    for (int h = 0; h < nheat; h++)
+        for (int g = 0; g < h; g++) {
+            const heat_spec *s = &heat[h], *t = &heat[g];
+            if (s->is_float != t->is_float || s->xf != t->xf ||
+                (!s->is_float && !s->xf &&
+                 (s->bits != t->bits || s->mant != t->mant || s->min_scale != t->min_scale)))
+                continue;
+            if (s->is_float)
+                fprintf(stderr, "cbvh sweep: --heatmap: float given twice\n");
+            else if (s->xf)
+                fprintf(stderr, "cbvh sweep: --heatmap: %s given twice\n", o.extra[s->xf - 1].name);
+            else
+                fprintf(stderr, "cbvh sweep: --heatmap: setting %d:%d:%d given twice\n", s->bits, s->mant,
+                        s->min_scale);
+            return 2;
+        }
     char outbuf[1024];
     if (!outdir) {
         default_out(scene, outbuf, sizeof outbuf);
@@ -466,7 +541,7 @@ int cmd_sweep(int argc, char **argv) {
         cbvh_scene_desc_free(&d);
         return 2;
     }
-    if (ensure_dir(outdir)) {
+    if (ensure_dir(outdir) || check_writable(outdir)) {
         cbvh_scene_desc_free(&d);
         return 2;
     }
@@ -491,7 +566,7 @@ int cmd_sweep(int argc, char **argv) {
     cbvh_sweep_per_ray(&ftot, &tp, fq);
     double *relv = calloc((size_t)res.nrows * SWEEP_NMETRICS, sizeof *relv);
     int *bits = calloc((size_t)nb, sizeof *bits);
-    if (!relv || !bits) abort();
+    if (!relv || !bits) cbvh_out_of_memory("sweep chart data");
     for (int b = 0; b < nb; b++) bits[b] = o.bits_lo + b;
     for (int i = 0; i < res.nrows; i++) {
         cbvh_fx_stats t = cbvh_fx_total(&res.rows[i].r);
@@ -508,9 +583,10 @@ int cmd_sweep(int argc, char **argv) {
     int status = res.all_same ? 0 : 1;
     char path[2048], title[1400];
     char written[16][2100];
-    int nwritten = 0;
+    int nwritten = 0, nfailed = 0;
+    char failed[1100] = ""; /* the first output file not written: one line at the end */
     double *x = calloc((size_t)nb, sizeof *x);
-    if (!x) abort();
+    if (!x) cbvh_out_of_memory("sweep chart axis");
     for (int b = 0; b < nb; b++) x[b] = bits[b];
     for (int c = 0; c < ncombo && nwritten < 8; c++) {
         const cbvh_sweep_setting *s = &res.rows[c * nb].s;
@@ -521,16 +597,15 @@ int cmd_sweep(int argc, char **argv) {
         const char *mesh = strrchr(d.mesh_spec, '/');
         snprintf(title, sizeof title, "%s: cost relative to the float BVH (M=%d, min scale %d)",
                  mesh ? mesh + 1 : d.mesh_spec, s->mant, s->min_scale);
+        /* Only the costs with a ratio (knee 0: the float BVH did none of it). */
         cbvh_svg_series ser[4];
-        for (int m = 0; m < 4; m++) ser[m] = (cbvh_svg_series){metric_names[m], &relv[(size_t)m * res.nrows + c * nb]};
-        int finite = 1;
+        int nser = 0;
         for (int m = 0; m < 4; m++)
-            for (int b = 0; b < nb; b++) finite &= ser[m].y[b] < 1e299;
-        if (!finite) continue; /* the float BVH did none of something: no chart */
-        if (cbvh_svg_chart(path, title, "coordinate bits N", "cost / float BVH", x, (size_t)nb, ser, 4, err,
-                           sizeof err)) {
-            fprintf(stderr, "cbvh sweep: %s\n", err);
-            status = status ? status : 2; /* an output file not written */
+            if (knee[c][m]) ser[nser++] = (cbvh_svg_series){metric_names[m], &relv[(size_t)m * res.nrows + c * nb]};
+        if (!nser) continue;
+        if (cbvh_svg_chart(path, title, "coordinate bits N", "cost / float BVH", x, (size_t)nb, ser, (size_t)nser,
+                           err, sizeof err)) {
+            if (!nfailed++) snprintf(failed, sizeof failed, "%s", err);
         } else
             snprintf(written[nwritten++], sizeof written[0], "%s", path);
     }
@@ -567,15 +642,13 @@ int cmd_sweep(int argc, char **argv) {
             snprintf(path, sizeof path, "%s/heat-N%d.png", outdir, heat[h].bits);
         if (cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res.width, (unsigned)res.height, 0, vmax, 0, &used_min,
                              &used_max, err, sizeof err)) {
-            fprintf(stderr, "cbvh sweep: %s\n", err);
-            status = status ? status : 2; /* an output file not written */
+            if (!nfailed++) snprintf(failed, sizeof failed, "%s", err);
         } else if (nwritten < 16)
             snprintf(written[nwritten++], sizeof written[0], "%s", path);
     }
     snprintf(path, sizeof path, "%s/render-float.png", outdir);
     if (cbvh_png_write(path, res.ref.image, (unsigned)res.width, (unsigned)res.height, 1, err, sizeof err)) {
-        fprintf(stderr, "cbvh sweep: %s\n", err);
-        status = status ? status : 2;
+        if (!nfailed++) snprintf(failed, sizeof failed, "%s", err);
     } else if (nwritten < 16)
         snprintf(written[nwritten++], sizeof written[0], "%s", path);
 
@@ -588,7 +661,10 @@ int cmd_sweep(int argc, char **argv) {
     for (int k = 0; first_bad < 0 && k < res.nextra; k++)
         if (!res.extra[k].same) first_bad = res.nrows + k;
     static const char *knee_keys[4] = {"box_tests", "tri_tests", "bytes", "model_time"};
-    if (json) {
+    if (nfailed) status = status ? status : 2; /* an output file not written */
+    /* A file not written: no JSON (its "files" would pass for a complete run),
+     * only the error line below, as trace and run print no JSON on an error. */
+    if (json && !nfailed) {
         cJSON *root = cJSON_CreateObject();
         cJSON_AddStringToObject(root, "scene", scene);
         cJSON_AddStringToObject(root, "mesh", d.mesh_spec);
@@ -660,7 +736,11 @@ int cmd_sweep(int argc, char **argv) {
             cJSON_AddNumberToObject(k, "min_scale", res.rows[c * nb].s.min_scale);
             cJSON_AddNumberToObject(k, "tolerance", tol);
             cJSON_AddNumberToObject(k, "reference_bits", o.bits_hi);
-            for (int m = 0; m < 4; m++) cJSON_AddNumberToObject(k, knee_keys[m], knee[c][m]);
+            for (int m = 0; m < 4; m++)
+                if (knee[c][m])
+                    cJSON_AddNumberToObject(k, knee_keys[m], knee[c][m]);
+                else
+                    cJSON_AddNullToObject(k, knee_keys[m]); /* no ratio: the float BVH did none */
             cJSON_AddItemToArray(kn, k);
         }
         cJSON_AddBoolToObject(root, "same_hits", res.all_same);
@@ -668,10 +748,12 @@ int cmd_sweep(int argc, char **argv) {
         cJSON *wr = cJSON_AddArrayToObject(root, "files");
         for (int k = 0; k < nwritten; k++) cJSON_AddItemToArray(wr, cJSON_CreateString(written[k]));
         char *txt = cJSON_PrintUnformatted(root);
-        printf("%s\n", txt);
+        if (!txt) cbvh_out_of_memory("sweep JSON");
+        cbvh_json_fputs_utf8(txt, stdout); /* file names may hold bytes that are not UTF-8 */
+        putchar('\n');
         free(txt);
         cJSON_Delete(root);
-    } else {
+    } else if (!json) {
         printf("scene %s: %s, %u triangles, %dx%d, %d spp, %d frame%s; %llu rays per setting\n", scene, d.mesh_spec,
                d.mesh.ntris, res.width, res.height, res.spp, res.frames, res.frames > 1 ? "s" : "",
                (unsigned long long)res.ref_rays);
@@ -709,20 +791,30 @@ int cmd_sweep(int argc, char **argv) {
         printf("\n");
         printf("knee = smallest N from which every finer N costs at most %ld%% more than N=%d (totals over effects):\n",
                knee_pct, o.bits_hi);
+        int no_knee = 0;
         for (int c = 0; c < ncombo; c++) {
             printf("  M=%d E=%d:", res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale);
-            for (int m = 0; m < 4; m++)
-                printf("%s %s N=%d", m ? "," : "", metric_names[m], knee[c][m]);
+            for (int m = 0; m < 4; m++) {
+                if (knee[c][m])
+                    printf("%s %s N=%d", m ? "," : "", metric_names[m], knee[c][m]);
+                else
+                    printf("%s %s -", m ? "," : "", metric_names[m]);
+                no_knee |= !knee[c][m];
+            }
             printf("\n");
         }
+        if (no_knee) printf("  (-: the float BVH did none of it, so there is no ratio and no knee)\n");
         for (int c = 0; c < ncombo; c++)
             for (int b = 0; b < nb; b++)
-                if (bits[b] == 6 && res.rows[c * nb].s.mant == CBVH_MANT_MAX)
+                if (bits[b] == 6 && res.rows[c * nb].s.mant == CBVH_MANT_MAX) {
                     printf("paper (Viitanen et al., CBVH at N=6): box tests x1.08, triangle tests x1.13; here (M=%d "
-                           "E=%d): box tests x%.3f, triangle tests x%.3f\n",
-                           res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale,
-                           relv[(size_t)SWEEP_BOX * res.nrows + c * nb + b],
-                           relv[(size_t)SWEEP_TRI * res.nrows + c * nb + b]);
+                           "E=%d): box tests",
+                           res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale);
+                    print_x(relv[(size_t)SWEEP_BOX * res.nrows + c * nb + b]);
+                    printf(", triangle tests");
+                    print_x(relv[(size_t)SWEEP_TRI * res.nrows + c * nb + b]);
+                    printf("\n");
+                }
         if (res.all_same)
             printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
                    "false misses) and render the same %dx%d image\n",
@@ -754,6 +846,9 @@ int cmd_sweep(int argc, char **argv) {
         fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits, r->s.mant,
                 r->s.min_scale, r->why);
     }
+    if (nfailed)
+        fprintf(stderr, "cbvh sweep: %s%s\n", failed,
+                nfailed > 1 ? " (and more output files not written)" : "");
     free(x);
     free(bits);
     free(relv);

@@ -80,20 +80,9 @@ static per_ray summarize(const cbvh_fx_stats *s, const cbvh_timing_params *tp) {
     return p;
 }
 
-/* A JSON string literal (paths may hold quotes, backslashes, control bytes). */
-static void json_str(const char *s) {
-    putchar('"');
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            printf("\\%c", c);
-        else if (c < 0x20)
-            printf("\\u%04x", c);
-        else
-            putchar(c);
-    }
-    putchar('"');
-}
+/* A JSON string literal (paths may hold quotes, backslashes, control bytes
+ * and bytes that are not UTF-8). */
+static void json_str(const char *s) { cbvh_json_str(s, stdout); }
 
 static double ratio(double a, double b) { return b > 0 ? a / b : 0; }
 
@@ -272,10 +261,12 @@ int cmd_trace(int argc, char **argv) {
         json_str(d.mesh_spec);
         printf(",\"triangles\":%u,\"frames\":%d,\"camera\":\"%s\",\"width\":%d,"
                "\"height\":%d,\"spp\":%d,\"one_sided\":%s,\"format\":\"%s\",\"bits\":%d,\"mant\":%d,\"min_scale\":%d,"
+               "\"camera_samples_without_ray\":%llu,\"pixels_without_camera_ray\":%llu,"
                "\"timing\":{\"box_cycles\":%g,\"tri_cycles\":%g,\"fetch_latency\":%g,\"dram_bytes_per_cycle\":%g,"
                "\"clock_mhz\":%g}",
                d.mesh.ntris, rf.frames, cams[d.camera.type], d.camera.width, d.camera.height,
-               spp_used, one_sided ? "true" : "false", fmt == CBVH_FORMAT_TLIST ? tlname : cbvh_format_name(fmt), bits, mant, min_scale, tp.box_cycles,
+               spp_used, one_sided ? "true" : "false", fmt == CBVH_FORMAT_TLIST ? tlname : cbvh_format_name(fmt), bits, mant, min_scale,
+               (unsigned long long)rf.samples_without_ray, (unsigned long long)rf.pixels_without_ray, tp.box_cycles,
                tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
         json_result("float", &d, &rf, &tp);
         if (cmp) {
@@ -329,9 +320,14 @@ int cmd_trace(int argc, char **argv) {
                        (unsigned long long)main_r->fx[e].rays);
             }
         if (unnamed) printf("\n");
-        if (main_r->pixels_without_ray)
-            printf("pixels without a camera ray (outside the fisheye circle): %llu\n",
-                   (unsigned long long)main_r->pixels_without_ray);
+        if (main_r->samples_without_ray)
+            printf("camera samples without a ray (outside the fisheye circle): %llu of %llu; pixels with no ray in "
+                   "any sample: %llu of %llu\n",
+                   (unsigned long long)main_r->samples_without_ray,
+                   (unsigned long long)d.camera.width * (unsigned long long)d.camera.height *
+                       (unsigned long long)spp_used * (unsigned long long)main_r->frames,
+                   (unsigned long long)main_r->pixels_without_ray,
+                   (unsigned long long)d.camera.width * (unsigned long long)d.camera.height);
         if (tm.rejected) printf("rays rejected by a unit (no hit): %llu\n", (unsigned long long)tm.rejected);
         print_units(&main_r->units, main_r->frames > 1);
         printf("build%s: %.3f s CPU%s\n", main_r->frames > 1 ? " + refits" : "", main_r->build_cpu_seconds,

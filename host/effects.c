@@ -12,6 +12,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "cbvh/oom.h"
+
 #define PI_F 3.14159265358979f
 
 /* ---- deterministic sampling: one splitmix64 stream per pixel sample ----- */
@@ -89,6 +91,7 @@ typedef struct {
     float eps;      /* secondary-ray origin offset along the normal */
     int frame;
     int px, py;     /* pixel being traced (for observers) */
+    uint8_t *had_ray; /* fisheye: per pixel, 1 once a sample made a camera ray (any frame) */
 } tracer;
 
 static double cpu_now(void) {
@@ -326,9 +329,10 @@ static void trace_frame(tracer *T) {
                 rng R = {mix64(d->seed * 0x9E3779B97F4A7C15u ^ mix64(pix + ((uint64_t)T->frame << 40)))};
                 float o[3], dir[3];
                 if (!camera_ray(c, x, y, spp, &R, o, dir)) {
-                    T->res->pixels_without_ray++;
+                    T->res->samples_without_ray++;
                     continue;
                 }
+                if (T->had_ray) T->had_ray[(size_t)y * (size_t)c->width + (size_t)x] = 1;
                 cbvh_trav_hit h;
                 if (trace(T, CBVH_FX_PRIMARY, CBVH_TRAV_CLOSEST, o, dir, INFINITY, UINT32_MAX, -1, &h))
                     shade(T, &R, o, dir, &h, 0);
@@ -453,7 +457,7 @@ static int build_cell_heads(tracer *T, char *err, size_t errlen) {
     T->cell_h = (c->height + 15) / 16;
     int ncx = (c->width + T->cell_w - 1) / T->cell_w, ncy = (c->height + T->cell_h - 1) / T->cell_h;
     T->cell_head = calloc((size_t)ncx * (size_t)ncy * CBVH_TLIST_MAX, sizeof *T->cell_head);
-    if (!T->cell_head) abort();
+    if (!T->cell_head) cbvh_out_of_memory("tile lists");
     for (int cy = 0; cy < ncy; cy++)
         for (int cx = 0; cx < ncx; cx++) {
             int x0 = cx * T->cell_w, y0 = cy * T->cell_h;
@@ -540,7 +544,7 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     r->frames = cbvh_scene_desc_frames(d);
     r->ntris = d->mesh.ntris;
     T.tris = malloc((size_t)d->mesh.ntris * sizeof *T.tris);
-    if (!T.tris) abort();
+    if (!T.tris) cbvh_out_of_memory("frame triangles");
     cbvh_scene_desc_frame(d, 0, T.tris);
     cbvh_scene frame0 = d->mesh;
     frame0.tris = T.tris;
@@ -577,6 +581,11 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     } else
         r->node_bytes = cbvh_bvh_bytes(&T.bvh);
     r->build_cpu_seconds = cpu_now() - b0;
+    size_t npx = (size_t)d->camera.width * (size_t)d->camera.height;
+    if (d->camera.type == CBVH_CAM_FISHEYE) { /* only a fisheye leaves pixels without a ray */
+        T.had_ray = calloc(npx, 1);
+        if (!T.had_ray) cbvh_out_of_memory("fisheye pixel map");
+    }
     for (T.frame = 0; T.frame < r->frames; T.frame++) {
         if (T.frame > 0) {
             /* Animation: move the vertices and refit (never for a static scene). */
@@ -599,8 +608,10 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
         }
         trace_frame(&T);
     }
+    for (size_t p = 0; T.had_ray && p < npx; p++) r->pixels_without_ray += !T.had_ray[p];
     rc = 0;
 out:
+    free(T.had_ray);
     if (T.have_tree) cbvh_tree_free(&T.tree);
     if (T.have_qbvh) cbvh_qbvh_free(&T.qbvh);
     if (T.have_tl) {

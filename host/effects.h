@@ -92,7 +92,11 @@ typedef struct {
     uint32_t ntris;
     uint64_t node_bytes;     /* hierarchy + primitive IDs (frame 0) */
     uint64_t refits;         /* refit passes */
-    uint64_t pixels_without_ray; /* fisheye pixels outside the image circle */
+    /* Fisheye: camera samples (pixel x sample x frame) outside the image circle,
+     * which make no ray; and pixels none of whose samples made a ray in any
+     * frame (at most width x height). */
+    uint64_t samples_without_ray;
+    uint64_t pixels_without_ray;
     uint64_t hit_digest;     /* hash of every ray's hit (prim, t bits) */
     double build_cpu_seconds;
 } cbvh_fx_result;

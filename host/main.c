@@ -1,8 +1,10 @@
 /* cbvh: host tool of the low-precision ray-tracing accelerator kit. */
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "cbvh/oom.h"
 #include "commands.h"
 
 typedef struct {
@@ -25,6 +27,7 @@ static void usage(FILE *f) {
     fprintf(f, "usage: cbvh <command> [options]   (cbvh <command> --help for each)\n\ncommands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         fprintf(f, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "\noptions:\n  %-10s %s\n  %-10s %s\n", "--help", "this list", "--version", "print the version");
 }
 
 int cbvh_bad_option(const char *cmd, char **argv, int optind_now) {
@@ -48,7 +51,17 @@ static int finish_stdout(int rc) {
     return rc;
 }
 
+/* Out of memory deep in a builder (cbvh/oom.h) is a resource failure like
+ * any other: one line and exit status 2, not an abort.  exit, not _exit: the
+ * results printed so far are flushed; files in progress are temp names that
+ * are only renamed when complete, so nothing half-written looks finished. */
+static void on_out_of_memory(const char *what) {
+    fprintf(stderr, "cbvh: out of memory (%s)\n", what);
+    exit(2);
+}
+
 int main(int argc, char **argv) {
+    cbvh_set_oom_handler(on_out_of_memory);
     if (argc < 2) {
         usage(stderr);
         return 2;

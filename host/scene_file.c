@@ -13,6 +13,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "cbvh/oom.h"
 #include "scene_load.h"
 #include "timing_model.h"
 
@@ -76,8 +77,16 @@ static int get_num(pctx *c, const cJSON *obj, const char *parent, const char *ke
     if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
         return fail(c, f, "expected a number %s%g, %g]", lo_open ? "in (" : "in [", lo, hi);
     double x = it->valuedouble;
-    if (x < lo || (lo_open && x == lo) || x > hi)
-        return fail(c, f, "%.9g is out of range %s%g, %g]", x, lo_open ? "(" : "[", lo, hi);
+    if (x < lo || (lo_open && x == lo) || x > hi) {
+        /* The first of %.6g .. %.17g that reads back as x: %.9g printed
+         * 179.0000001 as 179, a value the message then called out of range (0, 179]. */
+        char xs[32];
+        for (int prec = 6; prec <= 17; prec++) {
+            snprintf(xs, sizeof xs, "%.*g", prec, x);
+            if (strtod(xs, NULL) == x) break;
+        }
+        return fail(c, f, "%s is out of range %s%g, %g]", xs, lo_open ? "(" : "[", lo, hi);
+    }
     *v = x;
     return 1;
 }
@@ -529,7 +538,7 @@ int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *d
     uint32_t total = d->mesh.ntris + (floor_mat >= 0 ? 2 : 0);
     cbvh_tri *tris = realloc(d->mesh.tris, (size_t)total * sizeof *tris);
     d->tri_material = malloc(total);
-    if (!tris || !d->tri_material) abort();
+    if (!tris || !d->tri_material) cbvh_out_of_memory("scene triangles");
     d->mesh.tris = tris;
     memset(d->tri_material, mesh_mat, total);
     if (floor_mat >= 0) add_floor(d, (float)floor_size, (uint8_t)floor_mat);
@@ -565,7 +574,7 @@ int cbvh_scene_file_load(const char *path, cbvh_scene_desc *d, char *err, size_t
     }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap);
-    if (!buf) abort();
+    if (!buf) cbvh_out_of_memory("scene file buffer");
     size_t got;
     while ((got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
         n += got;
@@ -578,7 +587,7 @@ int cbvh_scene_file_load(const char *path, cbvh_scene_desc *d, char *err, size_t
             }
             cap *= 2;
             buf = realloc(buf, cap);
-            if (!buf) abort();
+            if (!buf) cbvh_out_of_memory("scene file buffer");
         }
     }
     int rerr = ferror(f) ? errno : 0;

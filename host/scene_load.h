@@ -15,6 +15,11 @@
  * assimp dropped, non-finite vertices, and files without triangles. */
 int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errlen);
 
+/* The time cbvh_scene_import gives the importer before it is stopped as
+ * hung, in ms: 5 s plus 1 s per MB of the file and, for glTF (.gltf, .glb),
+ * of the distinct files its buffers and images name by relative URI. */
+long long cbvh_scene_import_limit_ms(const char *path);
+
 /* Procedural scenes (names for cbvh_scene_open); size 0 = the default, a
  * size outside the range is an error:
  *   cloth      finely tessellated plane at z = -0.4 (degenerate z axis) with a

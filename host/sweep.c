@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cbvh/oom.h"
+
 /* What the float reference returned for one ray. */
 typedef struct {
     uint32_t prim, t;
@@ -30,10 +32,7 @@ typedef struct {
 
 static void *xcalloc(size_t n, size_t sz) {
     void *p = calloc(n ? n : 1, sz);
-    if (!p) {
-        fprintf(stderr, "cbvh sweep: out of memory\n");
-        abort();
-    }
+    if (!p) cbvh_out_of_memory("sweep tables");
     return p;
 }
 
@@ -76,7 +75,7 @@ static void on_ray(void *vctx, const cbvh_fx_ray *fr) {
         if (c->nrec == c->caprec) {
             c->caprec = c->caprec ? 2 * c->caprec : 4096;
             c->rec = realloc(c->rec, c->caprec * sizeof *c->rec);
-            if (!c->rec) abort();
+            if (!c->rec) cbvh_out_of_memory("sweep reference records");
         }
         c->rec[c->nrec++] = (ray_rec){h.prim, h.t, (uint8_t)fr->effect, (uint8_t)fr->mode, (uint8_t)(h.hit != 0)};
         return;
@@ -275,6 +274,8 @@ void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, do
 }
 
 int cbvh_sweep_knee(const int *bits, const double *rel, int n, double tol) {
+    for (int i = 0; i < n; i++)
+        if (!isfinite(rel[i])) return 0; /* the float BVH did none: no ratios, no knee */
     double limit = (1 + tol) * rel[n - 1];
     int k = n - 1;
     while (k > 0 && rel[k - 1] <= limit) k--;

@@ -87,7 +87,8 @@ void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, do
 /* The knee of one cost curve: rel[i] is the relative cost at bits[i]
  * (ascending).  Returns the smallest bits[k] such that rel[j] <= (1 + tol) *
  * rel[n-1] for every j >= k: from N = knee on, more bits buy less than tol of
- * the cost.  n >= 1. */
+ * the cost.  n >= 1.  0 when a ratio is not finite (NaN: the float BVH and
+ * the setting did none; infinity: only the setting did some): no knee. */
 int cbvh_sweep_knee(const int *bits, const double *rel, int n, double tol);
 
 #endif

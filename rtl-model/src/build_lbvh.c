@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "lbvh_internal.h"
+#include "cbvh/oom.h"
 
 /* Spread the low 10 bits of x to every third bit. */
 static inline uint32_t spread3(uint32_t x) {
@@ -160,7 +161,7 @@ int cbvh_lbvh_leaves(const cbvh_scene *s, cbvh_lbvh_work *w, int with_ids, char 
     }
     uint32_t nn = 2 * m - 1, L = m - 1; /* L: first leaf node index */
     cbvh_bvh_node *nodes = malloc((size_t)nn * sizeof *nodes);
-    if (!nodes) abort();
+    if (!nodes) cbvh_out_of_memory("LBVH nodes");
     cbvh_bvh_node *lf = NULL; /* the current leaf */
     for (uint32_t i = 0, c = 0; i < n; i++) {
         uint32_t code = (uint32_t)(keys[i] >> 32), t = (uint32_t)keys[i];

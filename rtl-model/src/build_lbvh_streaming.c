@@ -24,6 +24,7 @@
 #include "bu_stream.h"
 #include "cbvh_layout.h"
 #include "lbvh_internal.h"
+#include "cbvh/oom.h"
 
 typedef struct {
     const cbvh_bvh_node *nodes;
@@ -92,7 +93,7 @@ int cbvh_build_lbvh_streaming(const cbvh_scene *s, const cbvh_compress_opts *o, 
         keys_pairs = 1;
     }
     fuse_ctx f = {w.nodes, m - 1, NULL, malloc((size_t)m * sizeof(uint32_t)), 0, 0, 0};
-    if (!f.pairs) abort();
+    if (!f.pairs) cbvh_out_of_memory("streaming build pair buffer");
     f.bu = cbvh_bu_open(o, out, stats, l.npairs, err, errlen);
     cbvh_lbvh_hierarchy(&w, on_inner, &f);
     if (m == 1) f.rc = cbvh_bu_leaf_root(f.bu, &w.nodes[0], 0, out->root_pair);

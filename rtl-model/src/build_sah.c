@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "cbvh/bvh.h"
+#include "cbvh/oom.h"
 
 typedef struct {
     float lo[3], hi[3];
@@ -70,7 +71,7 @@ int cbvh_build_sah(const cbvh_scene *s, int bins, int max_leaf, cbvh_bvh *out, c
     uint32_t *prims = malloc((size_t)n * sizeof *prims), *tmp = malloc((size_t)n * sizeof *tmp);
     cbvh_bvh_node *nodes = calloc(2 * (size_t)n, sizeof *nodes);
     task *stack = malloc(2 * (size_t)n * sizeof *stack);
-    if (!tb || !cen || !prims || !tmp || !nodes || !stack) abort();
+    if (!tb || !cen || !prims || !tmp || !nodes || !stack) cbvh_out_of_memory("SAH build buffers");
     for (uint32_t i = 0; i < n; i++) {
         cbvh_tri_bounds(&s->tris[i], tb[i].lo, tb[i].hi);
         for (int a = 0; a < 3; a++) cen[i][a] = 0.5f * tb[i].lo[a] + 0.5f * tb[i].hi[a]; /* no overflow */

@@ -5,6 +5,25 @@
 #include <string.h>
 
 #include "cbvh/bvh.h"
+#include "cbvh/oom.h"
+
+/* The out-of-memory report (cbvh/oom.h) lives here, in libcbvh_build, the
+ * lowest library that allocates; libcbvh proper (the units, also built for
+ * the firmware) never does. */
+static cbvh_oom_handler oom_handler;
+
+cbvh_oom_handler cbvh_set_oom_handler(cbvh_oom_handler h) {
+    cbvh_oom_handler old = oom_handler;
+    oom_handler = h;
+    return old;
+}
+
+_Noreturn void cbvh_out_of_memory(const char *what) {
+    if (oom_handler) oom_handler(what);
+    /* stderr is unbuffered: this line needs no allocation */
+    fprintf(stderr, "cbvh: out of memory (%s)\n", what);
+    abort();
+}
 
 void cbvh_bvh_free(cbvh_bvh *b) {
     free(b->nodes);
@@ -16,7 +35,7 @@ void cbvh_bvh_postorder(const cbvh_bvh *b, uint32_t *order) {
     /* Explicit stack of (node, children-pushed flag); depth <= nnodes. */
     uint32_t *stack = malloc(((size_t)b->nnodes + 1) * sizeof *stack);
     uint32_t sp = 0, n = 0;
-    if (!stack) abort();
+    if (!stack) cbvh_out_of_memory("post-order stack");
     stack[sp++] = b->root << 1;
     while (sp) {
         uint32_t e = stack[--sp], i = e >> 1;
@@ -71,7 +90,7 @@ int cbvh_bvh_check(const cbvh_bvh *b, const cbvh_scene *s, char *err, size_t err
     uint32_t *stack = malloc(((size_t)b->nnodes + 1) * sizeof *stack);
     int rc = -1;
     uint32_t sp = 0, visited = 0, prims = 0;
-    if (!seen || !pseen || !stack) abort();
+    if (!seen || !pseen || !stack) cbvh_out_of_memory("BVH check buffers");
     stack[sp++] = b->root;
     while (sp) {
         uint32_t i = stack[--sp];

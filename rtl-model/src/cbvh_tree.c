@@ -3,6 +3,7 @@
 #include <stdlib.h>
 
 #include "cbvh_layout.h"
+#include "cbvh/oom.h"
 
 void cbvh_tree_free(cbvh_tree *t) {
     free(t->pairs);
@@ -142,7 +143,7 @@ int cbvh_tree_check(const cbvh_tree *t, const cbvh_bvh *b, char *err, size_t err
     uint8_t *idseen = calloc(t->nids ? t->nids : 1, 1);
     int rc = -1;
     uint32_t sp = 0, pairs = 0, ids = 0;
-    if (!stack || !seen || !idseen) abort();
+    if (!stack || !seen || !idseen) cbvh_out_of_memory("CBVH check buffers");
     if (t->root_pair >= t->npairs || t->nids != b->nprims) {
         snprintf(err, errlen, "cbvh check: bad root pair or ID count");
         goto out;
@@ -251,7 +252,7 @@ double cbvh_tree_sah(const cbvh_tree *t) {
     double ar = area3(rlo, rhi, perim);
     if (!(ar > 0.0)) return 0.0;
     item *stack = malloc(((size_t)t->npairs + 2) * sizeof *stack);
-    if (!stack) abort();
+    if (!stack) cbvh_out_of_memory("CBVH cost stack");
     uint32_t sp = 0, visits = 0;
     stack[sp++] = (item){t->root_pair, t->root_ctx};
     double cost = 0.0;

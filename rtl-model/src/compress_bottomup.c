@@ -63,6 +63,7 @@
 #include "cbvh_layout.h"
 #include "grid.h"
 #include "unit_fast.h"
+#include "cbvh/oom.h"
 
 static int ctx_differs(cbvh_encoding enc, const cbvh_node_ctx *a, const cbvh_node_ctx *b) {
     for (int x = 0; x < 3; x++) {
@@ -364,11 +365,11 @@ struct cbvh_bu_stream {
 cbvh_bu_stream *cbvh_bu_open(const cbvh_compress_opts *o, cbvh_tree *t, cbvh_bu_stats *st, uint32_t npairs,
                              char *err, size_t errlen) {
     cbvh_bu_stream *s = malloc(sizeof *s);
-    if (!s) abort();
+    if (!s) cbvh_out_of_memory("bottom-up compressor state");
     s->bt = (bu_state){o, t, st, malloc(((size_t)npairs + 2) * sizeof(bt_item)), err, errlen};
     s->recs = malloc(((size_t)npairs + 1) * sizeof *s->recs);
     s->sp = 0;
-    if (!s->bt.stack || !s->recs) abort();
+    if (!s->bt.stack || !s->recs) cbvh_out_of_memory("bottom-up compressor stacks");
     return s;
 }
 
@@ -523,7 +524,7 @@ int cbvh_compress_bottomup(cbvh_bvh *b, const cbvh_tri *refit_tris, const cbvh_c
     const cbvh_params *p = &o->params;
     cbvh_bu_stream *s = cbvh_bu_open(o, out, stats, l.npairs, err, errlen);
     uint32_t *walk = malloc(((size_t)b->nnodes + 1) * sizeof *walk); /* node << 1 | children pushed */
-    if (!walk) abort();
+    if (!walk) cbvh_out_of_memory("bottom-up walk stack");
     uint32_t ws = 0, npairs = 0, nids = 0, emitted = 0;
     int rc = 0, not_tree = 0;
     walk[ws++] = b->root << 1;

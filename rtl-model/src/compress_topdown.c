@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "cbvh_layout.h"
+#include "cbvh/oom.h"
 
 int cbvh_compress_topdown(const cbvh_bvh *b, const cbvh_compress_opts *o, cbvh_tree *out, char *err, size_t errlen) {
     cbvh_layout l;
@@ -21,7 +22,7 @@ int cbvh_compress_topdown(const cbvh_bvh *b, const cbvh_compress_opts *o, cbvh_t
         cbvh_node_ctx ctx;
     } item;
     item *stack = malloc(((size_t)l.npairs + 2) * sizeof *stack);
-    if (!stack) abort();
+    if (!stack) cbvh_out_of_memory("top-down compressor stack");
     uint32_t sp = 0;
     int rc = 0;
     stack[sp++] = (item){b->root, out->root_ctx};

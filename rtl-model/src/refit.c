@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "cbvh/bvh.h"
+#include "cbvh/oom.h"
 
 static void box_union(float lo[3], float hi[3], const float blo[3], const float bhi[3]) {
     for (int a = 0; a < 3; a++) {
@@ -16,7 +17,7 @@ static void box_union(float lo[3], float hi[3], const float blo[3], const float 
 
 void cbvh_bvh_refit(cbvh_bvh *b, const cbvh_tri *tris) {
     uint32_t *order = malloc((size_t)b->nnodes * sizeof *order);
-    if (!order) abort();
+    if (!order) cbvh_out_of_memory("refit order");
     cbvh_bvh_postorder(b, order);
     for (uint32_t k = 0; k < b->nnodes; k++) {
         cbvh_bvh_node *n = &b->nodes[order[k]];

@@ -2,6 +2,7 @@
  * costs at the extremes, the ray-by-ray identity check (and that a corrupted
  * setting fails it), the heat-map data and the knee rule; the QBVH row
  * (--formats cbvh,qbvh). */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -235,6 +236,11 @@ static void test_knee_rule(void **state) {
     double c[] = {0.8, 0.9, 1.0, 1.0}; /* cheaper than the finest: within from the start */
     assert_int_equal(cbvh_sweep_knee(bits, c, 4, 0.10), 3);
     assert_int_equal(cbvh_sweep_knee(bits, c, 1, 0.10), 3);
+    /* The float BVH did none of a cost: ratios 0/0 or x/0 give no knee (0),
+     * not one computed from stand-in values. */
+    double u[] = {NAN, NAN, NAN, NAN}, v[] = {INFINITY, 1.0, 1.0, 1.0};
+    assert_int_equal(cbvh_sweep_knee(bits, u, 4, 0.10), 0);
+    assert_int_equal(cbvh_sweep_knee(bits, v, 4, 0.10), 0);
 }
 
 static void test_bad_options(void **state) {

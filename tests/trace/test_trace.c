@@ -505,8 +505,17 @@ static void cameras(void **state) {
     cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
     cbvh_fx_result r;
     run(&d, &o, &r);
-    assert_true(r.pixels_without_ray > 0);
-    assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays + r.pixels_without_ray, 400);
+    assert_true(r.samples_without_ray > 0);
+    assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays + r.samples_without_ray, 400);
+    assert_int_equal(r.pixels_without_ray, r.samples_without_ray); /* 1 spp: a sample is a pixel */
+    /* 8 spp: samples are counted as samples, pixels as pixels (at most 400); a
+     * pixel counts only when none of its 8 samples made a ray. */
+    o.spp = 8;
+    run(&d, &o, &r);
+    assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays + r.samples_without_ray, 8 * 400);
+    assert_true(r.pixels_without_ray > 0 && r.pixels_without_ray < 400);
+    assert_true(8 * r.pixels_without_ray < r.samples_without_ray); /* border pixels: some samples in, some out */
+    o.spp = 0;
     cbvh_scene_desc_free(&d);
     load("{\"mesh\": \"" MESH "\", \"camera\": {\"type\": \"thin_lens\", \"width\": 8, \"height\": 6, \"spp\": 3,"
          "\"position\": [0, 6, 22], \"target\": [0, 4.2, 0], \"aperture\": 0.5}, \"effects\": [\"primary\"]}",

@@ -1,0 +1,40 @@
+# cmake -DCBVH=... -DSCENE=... -DWORK=... -P out_unwritable.cmake
+# --out that exists but takes no files fails at once, in one line, before
+# anything is traced (not after the whole sweep, one line per file).
+# Root may write into a mode-555 directory, so the always-run case is /sys
+# (sysfs: no new files, even for root); a mode-555 directory is tried too
+# when not root.
+set(dirs "")
+if(IS_DIRECTORY /sys)
+    list(APPEND dirs /sys)
+endif()
+execute_process(COMMAND id -u OUTPUT_VARIABLE uid OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT uid STREQUAL "0")
+    file(REMOVE_RECURSE "${WORK}")
+    file(MAKE_DIRECTORY "${WORK}/ro")
+    file(CHMOD "${WORK}/ro" PERMISSIONS OWNER_READ OWNER_EXECUTE GROUP_READ GROUP_EXECUTE WORLD_READ WORLD_EXECUTE)
+    list(APPEND dirs "${WORK}/ro")
+else()
+    message(STATUS "running as root: a mode-555 directory is writable for root, not tried")
+endif()
+if(NOT dirs)
+    message(STATUS "no /sys and running as root: nothing to check")
+    return()
+endif()
+foreach(d IN LISTS dirs)
+    execute_process(COMMAND "${CBVH}" sweep "${SCENE}" --bits 6 --out "${d}"
+        RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 2)
+        message(FATAL_ERROR "--out ${d}: exit ${rc}, expected 2: ${out}${err}")
+    endif()
+    if(NOT out STREQUAL "")
+        message(FATAL_ERROR "--out ${d}: the sweep ran before the check:\n${out}")
+    endif()
+    if(NOT err MATCHES "^cbvh sweep: --out ${d}: cannot write files there: [^\n]+\n$")
+        message(FATAL_ERROR "--out ${d}: expected one line, got:\n${err}")
+    endif()
+endforeach()
+if(EXISTS "${WORK}/ro")
+    file(CHMOD "${WORK}/ro" PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE)
+endif()
+message(STATUS "ok: ${dirs}")
