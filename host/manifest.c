@@ -47,6 +47,19 @@ const cbvh_manifest_entry *cbvh_manifest_find(const cbvh_manifest *m, const char
     return NULL;
 }
 
+int cbvh_sha256_check(const char *path, const void *buf, size_t len, const char *want, char *err, size_t errlen) {
+    char hex[CBVH_SHA256_HEX_LEN + 1];
+    if (cbvh_sha256_hex(buf, len, hex) != 0) {
+        snprintf(err, errlen, "%s: SHA-256 failed (libcrypto)", path);
+        return -1;
+    }
+    if (strcmp(hex, want) != 0) {
+        snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path, want, hex);
+        return -1;
+    }
+    return 0;
+}
+
 int cbvh_manifest_set(cbvh_manifest *m, const char *name, const char *sha256) {
     size_t n = strlen(name);
     if (!cbvh_manifest_name_ok(name, n) || strlen(sha256) != CBVH_SHA256_HEX_LEN) return -1;
@@ -232,18 +245,9 @@ int cbvh_manifest_verify_dir(const char *dir, cbvh_manifest *m, char *err, size_
             snprintf(err, errlen, "%s (listed in MANIFEST)", why);
             goto bad;
         }
-        char hex[CBVH_SHA256_HEX_LEN + 1];
-        int hrc = cbvh_sha256_hex(buf, len, hex);
+        int hrc = cbvh_sha256_check(path, buf, len, m->e[i].sha256, err, errlen);
         free(buf);
-        if (hrc != 0) {
-            snprintf(err, errlen, "%s: SHA-256 failed (libcrypto)", path);
-            goto bad;
-        }
-        if (strcmp(hex, m->e[i].sha256) != 0) {
-            snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path,
-                     m->e[i].sha256, hex);
-            goto bad;
-        }
+        if (hrc != 0) goto bad;
     }
     DIR *d = opendir(dir);
     if (!d) {

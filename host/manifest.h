@@ -24,6 +24,10 @@ typedef struct {
 /* SHA-256 of a buffer as lower-case hex (libcrypto EVP).  0 or -1. */
 int cbvh_sha256_hex(const void *buf, size_t len, char hex[CBVH_SHA256_HEX_LEN + 1]);
 
+/* 0 if buf (the contents of path) hashes to want, else -1 with the one-line
+ * reason in err (a mismatch, or libcrypto failing). */
+int cbvh_sha256_check(const char *path, const void *buf, size_t len, const char *want, char *err, size_t errlen);
+
 /* Strict parse of a manifest held in memory; name is used in messages
  * ("name:line: what").  0 or -1 with err set; m is empty on error. */
 int cbvh_manifest_parse(const char *buf, size_t len, const char *name, cbvh_manifest *m, char *err, size_t errlen);

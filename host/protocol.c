@@ -196,8 +196,7 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
                 int ev = cbvh_parser_push(&l->rx, buf + off, (size_t)r - off, &used, &f, &e);
                 off += used;
                 if (ev == CBVH_PARSE_ERROR) {
-                    if (e.code == CBVH_E_CRC) got.crc_errors++;
-                    if (e.code == CBVH_E_CRC) l->st.crc_errors++;
+                    if (e.code == CBVH_E_CRC) got.crc_errors++, l->st.crc_errors++;
                     else if (e.code == CBVH_E_SYNC) l->st.sync_errors++;
                     else l->st.other_parse_errors++;
                     if (e.code == CBVH_E_CRC && e.seq_known && e.seq == seq) {

@@ -85,12 +85,9 @@ static int verify_single(const char *path, FILE *log, char *sha, char *err, size
         cbvh_manifest_free(&m);
         return -1;
     }
-    char hex[CBVH_SHA256_HEX_LEN + 1];
-    int hrc = cbvh_sha256_hex(buf, len, hex);
+    int hrc = cbvh_sha256_check(path, buf, len, e->sha256, err, errlen);
     free(buf);
-    if (hrc != 0 || strcmp(hex, e->sha256) != 0) {
-        snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path, e->sha256,
-                 hrc ? "?" : hex);
+    if (hrc != 0) {
         cbvh_manifest_free(&m);
         return -1;
     }
@@ -153,15 +150,9 @@ static int load_verified(const char *path, const char *sha, cbvh_vecfile *vf, ch
     char *buf;
     size_t len;
     if (cbvh_read_file(path, &buf, &len, err, errlen) != 0) return -1;
-    if (sha[0]) {
-        char hex[CBVH_SHA256_HEX_LEN + 1];
-        int hrc = cbvh_sha256_hex(buf, len, hex);
-        if (hrc != 0 || strcmp(hex, sha) != 0) {
-            snprintf(err, errlen, "%s: SHA-256 mismatch: MANIFEST says %.12s..., file has %.12s...", path, sha,
-                     hrc ? "?" : hex);
-            free(buf);
-            return -1;
-        }
+    if (sha[0] && cbvh_sha256_check(path, buf, len, sha, err, errlen) != 0) {
+        free(buf);
+        return -1;
     }
     cbvh_vec_status st = cbvh_vecfile_parse(buf, len, path, vf, err, errlen);
     free(buf);
