@@ -94,7 +94,8 @@ static void gen_block_signals(int block) {
 /* Writes one file to DIR/.NAME.tmp.PID (fsync'd) and hashes it;
  * then, under the directory lock, renames it into place and lists it in
  * DIR/MANIFEST (re-read just before, so parallel gens keep each other's
- * entries).  The manifest therefore always vouches for every finished file. */
+ * entries).  The manifest, or after a kill the journal, therefore always
+ * vouches for every finished file. */
 static int write_vecfile(const char *dir, const char *name, const cbvh_vecfile *vf, char *err, size_t errlen) {
     char path[4096], hex[CBVH_SHA256_HEX_LEN + 1];
     snprintf(path, sizeof path, "%s/%s", dir, name);
@@ -137,13 +138,21 @@ static int write_vecfile(const char *dir, const char *name, const cbvh_vecfile *
     gen_block_signals(1);
     int rc = -1, lock = cbvh_manifest_lock(dir, err, errlen);
     cbvh_manifest m;
+    /* The journal names the new entry before the rename, so that a kill
+     * between the rename and the manifest update leaves a vouched-for file. */
     if (lock >= 0 && cbvh_manifest_load(dir, &m, err, errlen) >= 0) {
-        if (cbvh_manifest_set(&m, name, hex) != 0)
+        int ok = cbvh_manifest_settle(dir, &m, err, errlen) == 0;
+        if (ok && cbvh_manifest_set(&m, name, hex) != 0) {
             snprintf(err, errlen, "%.900s: cannot list in MANIFEST (bad name or out of memory)", path);
-        else if (rename(gen_tmp, path) != 0)
+            ok = 0;
+        }
+        ok = ok && cbvh_manifest_journal_write(dir, name, hex, err, errlen) == 0;
+        if (ok && rename(gen_tmp, path) != 0) {
             snprintf(err, errlen, "%.900s: cannot write: %s", path, strerror(errno));
-        else
-            rc = cbvh_manifest_save(dir, &m, err, errlen);
+            cbvh_manifest_journal_remove(dir);
+            ok = 0;
+        }
+        if (ok && (rc = cbvh_manifest_save(dir, &m, err, errlen)) == 0) cbvh_manifest_journal_remove(dir);
         cbvh_manifest_free(&m);
     }
     cbvh_manifest_unlock(lock);
@@ -261,10 +270,14 @@ static int cmd_gen(int argc, char **argv) {
     cbvh_vecgen_specs(&sel, specs, n);
 
     char err[1024];
-    /* A malformed MANIFEST stops gen before it writes anything. */
+    /* A malformed MANIFEST (or journal) stops gen before it writes anything;
+     * read under the lock, as another gen may be in its commit step. */
     cbvh_manifest m;
-    if (cbvh_manifest_load(dir, &m, err, sizeof err) < 0) {
-        fprintf(stderr, "cbvh vectors gen: %s (fix or delete it)\n", err);
+    int lock = cbvh_manifest_lock(dir, err, sizeof err);
+    int loaded = lock >= 0 ? cbvh_manifest_load_journaled(dir, &m, err, sizeof err) : -1;
+    cbvh_manifest_unlock(lock);
+    if (loaded < 0) {
+        fprintf(stderr, "cbvh vectors gen: %s%s\n", err, lock >= 0 ? " (fix or delete it)" : "");
         free(specs);
         return 2;
     }

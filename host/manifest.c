@@ -39,6 +39,8 @@ void cbvh_manifest_free(cbvh_manifest *m) {
     free(m->e);
     m->e = NULL;
     m->n = m->cap = 0;
+    m->from_journal = 0;
+    m->from_journal_name[0] = '\0';
 }
 
 const cbvh_manifest_entry *cbvh_manifest_find(const cbvh_manifest *m, const char *name) {
@@ -133,35 +135,41 @@ bad:
 
 static void join(char *dst, size_t n, const char *dir, const char *name) { snprintf(dst, n, "%s/%s", dir, name); }
 
-int cbvh_manifest_load(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+/* Loads DIR/fname: 0, 1 when it does not exist (m empty), -1 with err set. */
+static int load_named(const char *dir, const char *fname, cbvh_manifest *m, char *err, size_t errlen) {
     memset(m, 0, sizeof *m);
     char path[4096];
-    join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
+    join(path, sizeof path, dir, fname);
     if (access(path, F_OK) != 0 && errno == ENOENT) return 1;
     char *buf;
     size_t len;
-    if (cbvh_read_file(path, &buf, &len, err, errlen) != 0) return -1;
+    if (cbvh_read_file(path, &buf, &len, err, errlen) != 0)
+        return access(path, F_OK) != 0 && errno == ENOENT ? 1 : -1; /* removed since (a journal) */
     int rc = cbvh_manifest_parse(buf, len, path, m, err, errlen);
     free(buf);
     return rc;
+}
+
+int cbvh_manifest_load(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    return load_named(dir, CBVH_MANIFEST_NAME, m, err, errlen);
 }
 
 static int by_name(const void *a, const void *b) {
     return strcmp(((const cbvh_manifest_entry *)a)->name, ((const cbvh_manifest_entry *)b)->name);
 }
 
-int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+static int save_named(const char *dir, const char *fname, cbvh_manifest *m, char *err, size_t errlen) {
     if (m->n) qsort(m->e, m->n, sizeof *m->e, by_name);
     char path[4096], tmp[4200];
-    join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
-    snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%ld", dir, CBVH_MANIFEST_NAME, (long)getpid());
+    join(path, sizeof path, dir, fname);
+    snprintf(tmp, sizeof tmp, "%s/.%s.tmp.%ld", dir, fname, (long)getpid());
     FILE *f = fopen(tmp, "wb");
     if (!f) {
         snprintf(err, errlen, "%s: cannot create: %s", tmp, strerror(errno));
         return -1;
     }
     for (size_t i = 0; i < m->n; i++) fprintf(f, "%s  %s\n", m->e[i].sha256, m->e[i].name);
-    /* On disk before the rename: a crash must not leave an empty MANIFEST. */
+    /* On disk before the rename: a crash must not leave an empty file. */
     int bad = fflush(f) != 0 || fsync(fileno(f)) != 0;
     bad |= ferror(f);
     bad |= fclose(f) != 0;
@@ -170,6 +178,84 @@ int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errl
         remove(tmp);
         return -1;
     }
+    return 0;
+}
+
+int cbvh_manifest_save(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    return save_named(dir, CBVH_MANIFEST_NAME, m, err, errlen);
+}
+
+int cbvh_manifest_journal_write(const char *dir, const char *name, const char *sha256, char *err, size_t errlen) {
+    cbvh_manifest j = {0};
+    if (cbvh_manifest_set(&j, name, sha256) != 0) {
+        snprintf(err, errlen, "%.900s/%s: bad name or out of memory", dir, name);
+        return -1;
+    }
+    int rc = save_named(dir, CBVH_MANIFEST_JOURNAL, &j, err, errlen);
+    cbvh_manifest_free(&j);
+    return rc;
+}
+
+void cbvh_manifest_journal_remove(const char *dir) {
+    char path[4096];
+    join(path, sizeof path, dir, CBVH_MANIFEST_JOURNAL);
+    unlink(path);
+}
+
+/* Journal entries whose file now hashes to them go into m (the rename
+ * happened; the manifest update did not).  Returns 1 when there is no
+ * journal, 0 or -1 as cbvh_manifest_load. */
+static int apply_journal(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    cbvh_manifest j;
+    int rc = load_named(dir, CBVH_MANIFEST_JOURNAL, &j, err, errlen);
+    if (rc != 0) return rc;
+    for (size_t i = 0; i < j.n && rc == 0; i++) {
+        char path[4096], hex[CBVH_SHA256_HEX_LEN + 1], why[512];
+        join(path, sizeof path, dir, j.e[i].name);
+        char *buf;
+        size_t len;
+        if (access(path, F_OK) != 0 && errno == ENOENT) continue; /* a new file, never renamed into place */
+        if (cbvh_read_file(path, &buf, &len, why, sizeof why) != 0) {
+            snprintf(err, errlen, "%s (listed in %s)", why, CBVH_MANIFEST_JOURNAL);
+            rc = -1;
+            break;
+        }
+        int hrc = cbvh_sha256_hex(buf, len, hex);
+        free(buf);
+        if (hrc != 0) {
+            snprintf(err, errlen, "%s: SHA-256 failed (libcrypto)", path);
+            rc = -1;
+        } else if (strcmp(hex, j.e[i].sha256) == 0) {
+            const cbvh_manifest_entry *e = cbvh_manifest_find(m, j.e[i].name);
+            if (e && strcmp(e->sha256, hex) == 0) continue; /* the manifest was updated too */
+            if (cbvh_manifest_set(m, j.e[i].name, hex) != 0) {
+                snprintf(err, errlen, "out of memory");
+                rc = -1;
+            } else if (m->from_journal++ == 0) {
+                snprintf(m->from_journal_name, sizeof m->from_journal_name, "%s", j.e[i].name);
+            }
+        }
+    }
+    cbvh_manifest_free(&j);
+    return rc;
+}
+
+int cbvh_manifest_load_journaled(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    int rc = cbvh_manifest_load(dir, m, err, errlen);
+    if (rc < 0) return -1;
+    int jrc = apply_journal(dir, m, err, errlen);
+    if (jrc < 0) {
+        cbvh_manifest_free(m);
+        return -1;
+    }
+    return rc == 1 && m->n == 0 ? 1 : 0;
+}
+
+int cbvh_manifest_settle(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
+    int rc = apply_journal(dir, m, err, errlen);
+    if (rc == 1) return 0;
+    if (rc < 0 || cbvh_manifest_save(dir, m, err, errlen) != 0) return -1;
+    cbvh_manifest_journal_remove(dir);
     return 0;
 }
 
@@ -224,7 +310,7 @@ static int ends_with(const char *s, const char *suffix) {
 
 int cbvh_manifest_verify_dir(const char *dir, cbvh_manifest *m, char *err, size_t errlen) {
     char path[4096];
-    int rc = cbvh_manifest_load(dir, m, err, errlen);
+    int rc = cbvh_manifest_load_journaled(dir, m, err, errlen);
     if (rc == 1) {
         join(path, sizeof path, dir, CBVH_MANIFEST_NAME);
         snprintf(err, errlen, "%s: missing (every vector directory needs a MANIFEST)", path);

@@ -19,7 +19,19 @@ typedef struct {
 typedef struct {
     cbvh_manifest_entry *e;
     size_t n, cap;
+    /* Entries taken from the journal (cbvh_manifest_load_journaled), and the
+     * first one's name, for the note that says so. */
+    size_t from_journal;
+    char from_journal_name[CBVH_MANIFEST_MAX_NAME + 1];
 } cbvh_manifest;
+
+/* DIR/.MANIFEST.pending: gen's journal.  Under the directory lock gen writes
+ * the new entry here, renames the file into place, rewrites MANIFEST, then
+ * removes the journal; so a gen killed between the rename and the manifest
+ * update (SIGKILL, a crash) leaves a file the journal vouches for.  Readers
+ * accept it (cbvh_manifest_load_journaled); the next gen settles it into
+ * MANIFEST (cbvh_manifest_settle). */
+#define CBVH_MANIFEST_JOURNAL ".MANIFEST.pending"
 
 /* SHA-256 of a buffer as lower-case hex (libcrypto EVP).  0 or -1. */
 int cbvh_sha256_hex(const void *buf, size_t len, char hex[CBVH_SHA256_HEX_LEN + 1]);
@@ -35,6 +47,19 @@ int cbvh_manifest_parse(const char *buf, size_t len, const char *name, cbvh_mani
 /* Loads DIR/MANIFEST.  Returns 0, 1 when the file does not exist (m empty),
  * -1 on any other error (err set). */
 int cbvh_manifest_load(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
+
+/* cbvh_manifest_load, then every journal entry whose file now has the
+ * SHA-256 the journal gives replaces the manifest's (counted in
+ * m->from_journal).  0, 1 when neither lists anything, -1 with err set. */
+int cbvh_manifest_load_journaled(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
+
+/* Writes the journal: one entry (name, sha256), temp file + fsync + rename. */
+int cbvh_manifest_journal_write(const char *dir, const char *name, const char *sha256, char *err, size_t errlen);
+void cbvh_manifest_journal_remove(const char *dir);
+
+/* Under the lock, with m just loaded: a journal left by a killed gen is
+ * applied to m, MANIFEST rewritten and the journal removed.  0 or -1. */
+int cbvh_manifest_settle(const char *dir, cbvh_manifest *m, char *err, size_t errlen);
 
 const cbvh_manifest_entry *cbvh_manifest_find(const cbvh_manifest *m, const char *name);
 

@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "backend.h"
+#include "commands.h"
 #include "manifest.h"
 #include "vecfile.h"
 
@@ -50,6 +51,15 @@ static int ends_with(const char *s, const char *suffix) {
     return n >= k && strcmp(s + n - k, suffix) == 0;
 }
 
+/* A file vouched for by the journal of a killed gen, not yet by MANIFEST. */
+static void note_journal(FILE *log, const char *dir, const cbvh_manifest *m) {
+    if (m->from_journal)
+        fprintf(log,
+                "cbvh: note: %s/%s%s was put in place by a `vectors gen` killed before it updated MANIFEST; "
+                "checked against the SHA-256 in %s/%s (the next gen there lists it)\n",
+                dir, m->from_journal_name, m->from_journal > 1 ? " and others" : "", dir, CBVH_MANIFEST_JOURNAL);
+}
+
 /* A single file: verified against the MANIFEST next to it when there is one;
  * sha receives the listed SHA-256 ("" without a MANIFEST). */
 static int verify_single(const char *path, FILE *log, char *sha, char *err, size_t errlen) {
@@ -67,7 +77,7 @@ static int verify_single(const char *path, FILE *log, char *sha, char *err, size
         strcpy(dir, ".");
     }
     cbvh_manifest m;
-    int rc = cbvh_manifest_load(dir, &m, err, errlen);
+    int rc = cbvh_manifest_load_journaled(dir, &m, err, errlen);
     if (rc < 0) return -1;
     if (rc == 1) {
         fprintf(log, "cbvh: note: no MANIFEST next to %s; its SHA-256 is not verified\n", path);
@@ -92,6 +102,7 @@ static int verify_single(const char *path, FILE *log, char *sha, char *err, size
         return -1;
     }
     memcpy(sha, e->sha256, CBVH_SHA256_HEX_LEN + 1);
+    note_journal(log, dir, &m);
     cbvh_manifest_free(&m);
     return 0;
 }
@@ -109,6 +120,7 @@ static int collect(const char *const *paths, int npaths, FILE *log, list_t *file
             for (size_t k = strlen(d); k > 1 && d[k - 1] == '/'; k--) d[k - 1] = '\0'; /* "vectors/" -> "vectors" */
             cbvh_manifest m;
             if (cbvh_manifest_verify_dir(d, &m, err, errlen) != 0) return -1;
+            note_journal(log, d, &m);
             /* Leftovers of a killed gen are not vector files: named, not run. */
             char first[4200];
             size_t temps = cbvh_manifest_find_temps(d, first, sizeof first);
@@ -230,22 +242,11 @@ static void print_mismatch_text(FILE *f, const char *path, const cbvh_vecfile *v
     }
 }
 
-static void json_str(FILE *f, const char *s) {
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
-        else if (c < 0x20) fprintf(f, "\\u%04x", c);
-        else fputc(c, f);
-    }
-    fputc('"', f);
-}
-
 static void json_mismatch(FILE *f, const char *path, const cbvh_vecfile *vf, size_t i, const uint32_t *act) {
     const cbvh_layout *l = &vf->layout;
     const uint32_t *in = vf->in + i * (size_t)l->n_in, *exp = vf->out + i * (size_t)l->n_out;
     fprintf(f, "{\"file\": ");
-    json_str(f, path);
+    cbvh_json_str(path, f);
     fprintf(f, ", \"line\": %zu, \"unit\": \"%s\", \"inputs\": {", vf->first_line + i, vf->unit->name);
     for (int k = 0; k < l->n_in; k++)
         fprintf(f, "%s\"%s\": \"%0*" PRIX32 "\"", k ? ", " : "", l->in[k].name, l->in[k].hex_digits, in[k]);
@@ -294,7 +295,7 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
     snprintf(sum.backend, sizeof sum.backend, "%s", be.label);
     if (o.json) {
         fprintf(out, "{\"backend\": ");
-        json_str(out, be.label);
+        cbvh_json_str(be.label, out);
         fprintf(out, ", \"files\": [");
     } else {
         fprintf(out, "backend: %s\n", be.label);
@@ -343,7 +344,7 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
         in_obj = o.json;
         if (o.json) {
             fprintf(out, "%s{\"file\": ", fi ? ", " : "");
-            json_str(out, path);
+            cbvh_json_str(path, out);
             fprintf(out, ", \"unit\": \"%s\", \"mismatches\": [", vf.unit->name);
         }
         for (size_t off = 0; off < m; off += batch) {
@@ -409,7 +410,7 @@ done_json:
                 printed < o.max_errors ? printed : o.max_errors, rc);
         if (rc == CBVH_CHECK_BAD_INPUT) {
             fprintf(out, ", \"error\": ");
-            json_str(out, err);
+            cbvh_json_str(err, out);
         }
         fprintf(out, "}\n");
     } else if (rc != CBVH_CHECK_BAD_INPUT) {
@@ -422,7 +423,7 @@ done_json:
 done:
     if (o.json) {
         fprintf(out, "{\"status\": %d, \"error\": ", rc);
-        json_str(out, err);
+        cbvh_json_str(err, out);
         fprintf(out, "}\n");
     }
 finish:

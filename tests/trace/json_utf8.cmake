@@ -1,6 +1,6 @@
 # cmake -DCBVH=... -DMESH=... -DWORK=... -P json_utf8.cmake
 # A file name that is not UTF-8 (here with the byte 0xFF) must not reach JSON
-# raw (invalid UTF-8): trace, sweep, run and study write such a byte as
+# raw (invalid UTF-8): trace, sweep, run, study and vectors check write such a byte as
 # \u00ff (commands.h), and their output parses and names the file.
 string(ASCII 255 ff)
 string(ASCII 195 191 ff_utf8) # U+00FF in UTF-8: what a JSON reader decodes \u00ff to
@@ -44,6 +44,22 @@ foreach(cmd trace sweep run study)
         endif()
     endif()
 endforeach()
+# vectors check: file paths in its JSON (here a folder named with 0xFF).
+execute_process(COMMAND "${CBVH}" vectors gen -u ray_box --bits 4 -o "${WORK}/vec${ff}" RESULT_VARIABLE rc ERROR_VARIABLE err
+                OUTPUT_QUIET)
+if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "cbvh vectors gen into vec\\xff: exit ${rc}: ${err}")
+endif()
+execute_process(COMMAND "${CBVH}" vectors check --backend model --json "${WORK}/vec${ff}" RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(FIND "${out}" "${ff}" pos)
+if(NOT rc EQUAL 0 OR NOT pos EQUAL -1 OR NOT out MATCHES "vec\\\\u00ff/ray_box")
+    message(FATAL_ERROR "cbvh vectors check --json: exit ${rc}, raw 0xFF at ${pos}: ${out}${err}")
+endif()
+string(JSON f GET "${out}" files 0 file)
+if(NOT f MATCHES "/vec${ff_utf8}/ray_box")
+    message(FATAL_ERROR "cbvh vectors check --json: files[0].file reads back as '${f}'")
+endif()
 # Well-formed UTF-8 is left as it is.
 string(ASCII 195 169 e_acute)
 file(COPY_FILE "${MESH}" "${WORK}/caf${e_acute}.obj")

@@ -403,7 +403,7 @@ static void make_dir_with(const char *unit, int bits, const char *name) {
     write_bytes(name, text, len);
     char hex[65];
     assert_int_equal(cbvh_sha256_hex(text, len, hex), 0);
-    cbvh_manifest m = {NULL, 0, 0};
+    cbvh_manifest m = {0};
     assert_int_equal(cbvh_manifest_set(&m, name, hex), 0);
     assert_int_equal(cbvh_manifest_save(dir, &m, err, sizeof err), 0);
     cbvh_manifest_free(&m);
@@ -512,7 +512,7 @@ static void test_check_bad_vector_file(void **state) {
     char hex[65];
     cbvh_sha256_hex(buf, len, hex);
     free(buf);
-    cbvh_manifest m = {NULL, 0, 0};
+    cbvh_manifest m = {0};
     cbvh_manifest_set(&m, "bad_hex.vec", hex);
     assert_int_equal(cbvh_manifest_save(dir, &m, err, sizeof err), 0);
     cbvh_manifest_free(&m);
@@ -540,7 +540,7 @@ static void test_check_mismatch(void **state) {
     write_bytes("x.vec", text, len);
     char hex[65];
     cbvh_sha256_hex(text, len, hex);
-    cbvh_manifest m = {NULL, 0, 0};
+    cbvh_manifest m = {0};
     cbvh_manifest_set(&m, "x.vec", hex);
     assert_int_equal(cbvh_manifest_save(dir, &m, err, sizeof err), 0);
     cbvh_manifest_free(&m);
@@ -559,6 +559,109 @@ static void test_check_mismatch(void **state) {
     assert_true(strstr(cub, "<-- differs") == NULL || strstr(cub, "<-- differs") > strchr(cub, '\n'));
     assert_non_null(strstr(out, " passed, 1 failed\n"));
     assert_non_null(strstr(out, "total: 1 files, "));
+    free(out);
+    free(log);
+    free(text);
+    remove_dir();
+}
+
+/* gen's journal (.MANIFEST.pending): a file renamed into place by a gen
+ * killed before it rewrote MANIFEST is accepted with a note, a stale journal
+ * changes nothing, a file matching neither fails, and settle lists it. */
+static void test_manifest_journal(void **state) {
+    (void)state;
+    make_dir_with("scale_estimate", 4, "a.vec");
+    size_t len;
+    char *text = gen_text("scale_estimate", 5, &len), hex[65], old_hex[65];
+    assert_int_equal(cbvh_sha256_hex(text, len, hex), 0);
+    cbvh_manifest m;
+    assert_int_equal(cbvh_manifest_load(dir, &m, err, sizeof err), 0);
+    snprintf(old_hex, sizeof old_hex, "%s", m.e[0].sha256);
+    cbvh_manifest_free(&m);
+    char *out, *log;
+
+    /* Killed before the rename: the old file still matches MANIFEST. */
+    assert_int_equal(cbvh_manifest_journal_write(dir, "a.vec", hex, err, sizeof err), 0);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
+    assert_null(strstr(log, "killed"));
+    free(out);
+    free(log);
+
+    /* Killed after the rename: the new file matches the journal only. */
+    write_bytes("a.vec", text, len);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
+    assert_non_null(strstr(log, "a.vec was put in place by a `vectors gen` killed before it updated MANIFEST"));
+    assert_non_null(strstr(out, " passed, 0 failed"));
+    free(out);
+    free(log);
+    char path[600];
+    snprintf(path, sizeof path, "%s/a.vec", dir);
+    {
+        size_t ol, ll;
+        FILE *fo = open_memstream(&out, &ol), *fl = open_memstream(&log, &ll);
+        cbvh_check_opts o;
+        memset(&o, 0, sizeof o);
+        o.backend = "model";
+        o.max_errors = 20;
+        o.out = fo;
+        o.log = fl;
+        const char *paths[1] = {path};
+        assert_int_equal(cbvh_vectors_check(paths, 1, &o), CBVH_CHECK_PASS);
+        fclose(fo);
+        fclose(fl);
+        assert_non_null(strstr(log, "killed before it updated MANIFEST"));
+        free(out);
+        free(log);
+    }
+
+    /* Neither: one byte changed. */
+    text[len - 2] = text[len - 2] == '0' ? '1' : '0';
+    write_bytes("a.vec", text, len);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_BAD_INPUT);
+    assert_non_null(strstr(log, "a.vec: SHA-256 mismatch: MANIFEST says"));
+    free(out);
+    free(log);
+    text[len - 2] = text[len - 2] == '0' ? '1' : '0';
+    write_bytes("a.vec", text, len);
+
+    /* Settling (the next gen, under the lock) lists it and drops the journal. */
+    assert_int_equal(cbvh_manifest_load(dir, &m, err, sizeof err), 0);
+    assert_int_equal(cbvh_manifest_settle(dir, &m, err, sizeof err), 0);
+    cbvh_manifest_free(&m);
+    assert_int_equal(cbvh_manifest_load(dir, &m, err, sizeof err), 0);
+    assert_int_equal(m.n, 1);
+    assert_string_equal(m.e[0].sha256, hex);
+    assert_string_not_equal(m.e[0].sha256, old_hex);
+    cbvh_manifest_free(&m);
+    snprintf(path, sizeof path, "%s/%s", dir, CBVH_MANIFEST_JOURNAL);
+    assert_int_equal(access(path, F_OK), -1);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
+    assert_null(strstr(log, "killed"));
+    free(out);
+    free(log);
+
+    /* A new file the journal vouches for is not "unlisted"; absent, it is ignored. */
+    write_bytes("c.vec", text, len);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_BAD_INPUT);
+    assert_non_null(strstr(log, "c.vec: vector file not listed in MANIFEST"));
+    free(out);
+    free(log);
+    assert_int_equal(cbvh_manifest_journal_write(dir, "c.vec", hex, err, sizeof err), 0);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
+    assert_non_null(strstr(log, "c.vec was put in place"));
+    free(out);
+    free(log);
+    snprintf(path, sizeof path, "%s/c.vec", dir);
+    remove(path);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
+    assert_null(strstr(log, "killed"));
+    free(out);
+    free(log);
+
+    /* A malformed journal is named. */
+    write_bytes(CBVH_MANIFEST_JOURNAL, "deadbeef  a.vec\n", 16);
+    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_BAD_INPUT);
+    assert_non_null(strstr(log, ".MANIFEST.pending:1: malformed line"));
     free(out);
     free(log);
     free(text);
@@ -712,6 +815,7 @@ int main(void) {
         cmocka_unit_test(test_check_bad_vector_file),
         cmocka_unit_test(test_check_mismatch),
         cmocka_unit_test(test_auto_falls_back),
+        cmocka_unit_test(test_manifest_journal),
         cmocka_unit_test(test_manifest_crlf),
         cmocka_unit_test(test_temp_names),
         cmocka_unit_test(test_check_file_rewritten_after_verify),
