@@ -416,8 +416,24 @@ static void remove_dir(void) {
     assert_int_equal(system(cmd), 0);
 }
 
+static int run_check_path(const char *path, const char *backend, char **out, char **log);
+
 /* Runs check on dir; returns the status; out/log captured. */
-static int run_check(const char *backend, char **out, char **log) {
+static int run_check(const char *backend, char **out, char **log) { return run_check_path(dir, backend, out, log); }
+
+/* check of path on the model: status want, log_has (if not NULL) in its log,
+ * log_lacks (if not NULL) not. */
+static void check_should(const char *path, int want, const char *log_has, const char *log_lacks) {
+    char *out, *log;
+    assert_int_equal(run_check_path(path, "model", &out, &log), want);
+    if (log_has && !strstr(log, log_has)) fail_msg("'%s' not in: %s", log_has, log);
+    if (log_lacks && strstr(log, log_lacks)) fail_msg("'%s' in: %s", log_lacks, log);
+    if (want == CBVH_CHECK_PASS) assert_non_null(strstr(out, " passed, 0 failed"));
+    free(out);
+    free(log);
+}
+
+static int run_check_path(const char *path, const char *backend, char **out, char **log) {
     size_t ol, ll;
     FILE *fo = open_memstream(out, &ol), *fl = open_memstream(log, &ll);
     cbvh_check_opts o;
@@ -426,7 +442,7 @@ static int run_check(const char *backend, char **out, char **log) {
     o.max_errors = 20;
     o.out = fo;
     o.log = fl;
-    const char *paths[1] = {dir};
+    const char *paths[1] = {path};
     int rc = cbvh_vectors_check(paths, 1, &o);
     fclose(fo);
     fclose(fl);
@@ -578,49 +594,24 @@ static void test_manifest_journal(void **state) {
     assert_int_equal(cbvh_manifest_load(dir, &m, err, sizeof err), 0);
     snprintf(old_hex, sizeof old_hex, "%s", m.e[0].sha256);
     cbvh_manifest_free(&m);
-    char *out, *log;
+    const char *note = "was put in place by a `vectors gen` killed before it updated MANIFEST";
+    char path[600];
+    snprintf(path, sizeof path, "%s/a.vec", dir);
 
     /* Killed before the rename: the old file still matches MANIFEST. */
     assert_int_equal(cbvh_manifest_journal_write(dir, "a.vec", hex, err, sizeof err), 0);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
-    assert_null(strstr(log, "killed"));
-    free(out);
-    free(log);
+    check_should(dir, CBVH_CHECK_PASS, NULL, note);
 
-    /* Killed after the rename: the new file matches the journal only. */
+    /* Killed after the rename: the new file matches the journal only
+     * (checked as a directory and as a single file). */
     write_bytes("a.vec", text, len);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
-    assert_non_null(strstr(log, "a.vec was put in place by a `vectors gen` killed before it updated MANIFEST"));
-    assert_non_null(strstr(out, " passed, 0 failed"));
-    free(out);
-    free(log);
-    char path[600];
-    snprintf(path, sizeof path, "%s/a.vec", dir);
-    {
-        size_t ol, ll;
-        FILE *fo = open_memstream(&out, &ol), *fl = open_memstream(&log, &ll);
-        cbvh_check_opts o;
-        memset(&o, 0, sizeof o);
-        o.backend = "model";
-        o.max_errors = 20;
-        o.out = fo;
-        o.log = fl;
-        const char *paths[1] = {path};
-        assert_int_equal(cbvh_vectors_check(paths, 1, &o), CBVH_CHECK_PASS);
-        fclose(fo);
-        fclose(fl);
-        assert_non_null(strstr(log, "killed before it updated MANIFEST"));
-        free(out);
-        free(log);
-    }
+    check_should(dir, CBVH_CHECK_PASS, "a.vec was put in place", NULL);
+    check_should(path, CBVH_CHECK_PASS, note, NULL);
 
     /* Neither: one byte changed. */
     text[len - 2] = text[len - 2] == '0' ? '1' : '0';
     write_bytes("a.vec", text, len);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_BAD_INPUT);
-    assert_non_null(strstr(log, "a.vec: SHA-256 mismatch: MANIFEST says"));
-    free(out);
-    free(log);
+    check_should(dir, CBVH_CHECK_BAD_INPUT, "a.vec: SHA-256 mismatch: MANIFEST says", NULL);
     text[len - 2] = text[len - 2] == '0' ? '1' : '0';
     write_bytes("a.vec", text, len);
 
@@ -633,37 +624,23 @@ static void test_manifest_journal(void **state) {
     assert_string_equal(m.e[0].sha256, hex);
     assert_string_not_equal(m.e[0].sha256, old_hex);
     cbvh_manifest_free(&m);
-    snprintf(path, sizeof path, "%s/%s", dir, CBVH_MANIFEST_JOURNAL);
-    assert_int_equal(access(path, F_OK), -1);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
-    assert_null(strstr(log, "killed"));
-    free(out);
-    free(log);
+    char jpath[600];
+    snprintf(jpath, sizeof jpath, "%s/%s", dir, CBVH_MANIFEST_JOURNAL);
+    assert_int_equal(access(jpath, F_OK), -1);
+    check_should(dir, CBVH_CHECK_PASS, NULL, note);
 
     /* A new file the journal vouches for is not "unlisted"; absent, it is ignored. */
     write_bytes("c.vec", text, len);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_BAD_INPUT);
-    assert_non_null(strstr(log, "c.vec: vector file not listed in MANIFEST"));
-    free(out);
-    free(log);
+    check_should(dir, CBVH_CHECK_BAD_INPUT, "c.vec: vector file not listed in MANIFEST", NULL);
     assert_int_equal(cbvh_manifest_journal_write(dir, "c.vec", hex, err, sizeof err), 0);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
-    assert_non_null(strstr(log, "c.vec was put in place"));
-    free(out);
-    free(log);
+    check_should(dir, CBVH_CHECK_PASS, "c.vec was put in place", NULL);
     snprintf(path, sizeof path, "%s/c.vec", dir);
     remove(path);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_PASS);
-    assert_null(strstr(log, "killed"));
-    free(out);
-    free(log);
+    check_should(dir, CBVH_CHECK_PASS, NULL, note);
 
     /* A malformed journal is named. */
     write_bytes(CBVH_MANIFEST_JOURNAL, "deadbeef  a.vec\n", 16);
-    assert_int_equal(run_check("model", &out, &log), CBVH_CHECK_BAD_INPUT);
-    assert_non_null(strstr(log, ".MANIFEST.pending:1: malformed line"));
-    free(out);
-    free(log);
+    check_should(dir, CBVH_CHECK_BAD_INPUT, ".MANIFEST.pending:1: malformed line", NULL);
     free(text);
     remove_dir();
 }
