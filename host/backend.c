@@ -74,24 +74,35 @@ static int open_auto(cbvh_backend *b, FILE *log, char *err, size_t errlen) {
     return open_one(&cbvh_backend_model, NULL, b, err, errlen) == CBVH_BACKEND_OK ? 0 : -1;
 }
 
+/* The backend a spec names ("name" or "name:arg"); *arg gets the text after
+ * the colon, or NULL.  NULL with err set for an unknown name. */
+static const cbvh_backend_ops *find_backend(const char *spec, const char **arg, char *err, size_t errlen) {
+    static const cbvh_backend_ops *const all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid,
+                                                  &cbvh_backend_sim};
+    size_t n = strcspn(spec, ":");
+    *arg = spec[n] == ':' ? spec + n + 1 : NULL;
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        if (strlen(all[i]->name) == n && strncmp(all[i]->name, spec, n) == 0) return all[i];
+    snprintf(err, errlen, "unknown backend '%s' (expected auto, model, usb, hid or sim:ADDR)", spec);
+    return NULL;
+}
+
+int cbvh_backend_spec_check(const char *spec, char *err, size_t errlen) {
+    if (strcmp(spec, "auto") == 0) return 0;
+    const char *arg;
+    const cbvh_backend_ops *ops = find_backend(spec, &arg, err, errlen);
+    if (!ops) return -1;
+    return ops->check_arg && ops->check_arg(arg, err, errlen) ? -1 : 0;
+}
+
 int cbvh_backend_open(const char *spec, cbvh_backend *b, FILE *log, char *err, size_t errlen) {
     if (strcmp(spec, "auto") == 0) return open_auto(b, log, err, errlen);
-    const cbvh_backend_ops *all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid, &cbvh_backend_sim};
-    size_t n = strcspn(spec, ":");
-    const char *arg = spec[n] == ':' ? spec + n + 1 : NULL;
-    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++) {
-        if (strlen(all[i]->name) == n && strncmp(all[i]->name, spec, n) == 0) {
-            if (arg && all[i] == &cbvh_backend_model) { /* an ignored argument would hide a typo */
-                snprintf(err, errlen, "the model backend takes no argument (got '%.100s'; use 'model')", spec);
-                return -1;
-            }
-            int rc = open_one(all[i], arg, b, err, errlen);
-            if (rc == CBVH_BACKEND_NONE && err[0] == '\0') snprintf(err, errlen, "no %s board found", all[i]->name);
-            return rc == CBVH_BACKEND_OK ? 0 : -1;
-        }
-    }
-    snprintf(err, errlen, "unknown backend '%s' (expected auto, model, usb, hid or sim:ADDR)", spec);
-    return -1;
+    if (cbvh_backend_spec_check(spec, err, errlen)) return -1;
+    const char *arg;
+    const cbvh_backend_ops *ops = find_backend(spec, &arg, err, errlen);
+    int rc = open_one(ops, arg, b, err, errlen);
+    if (rc == CBVH_BACKEND_NONE && err[0] == '\0') snprintf(err, errlen, "no %s board found", ops->name);
+    return rc == CBVH_BACKEND_OK ? 0 : -1;
 }
 
 void cbvh_backend_close(cbvh_backend *b) {

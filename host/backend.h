@@ -21,6 +21,10 @@ typedef struct cbvh_backend cbvh_backend;
 
 typedef struct {
     const char *name;
+    /* Checks the text after "name:" (NULL when there is none) without
+     * opening anything: 0, or CBVH_BACKEND_BAD_INPUT with err set.  NULL:
+     * any argument is accepted. */
+    int (*check_arg)(const char *arg, char *err, size_t errlen);
     /* Opens the backend; arg is the text after "name:" (or NULL).
      * Returns 0 on success, CBVH_BACKEND_NONE when no device is present,
      * CBVH_BACKEND_BAD_INPUT when arg or a setting is wrong (auto then fails
@@ -46,6 +50,11 @@ extern const cbvh_backend_ops cbvh_backend_model;
 extern const cbvh_backend_ops cbvh_backend_usb;
 extern const cbvh_backend_ops cbvh_backend_hid;
 extern const cbvh_backend_ops cbvh_backend_sim; /* transport_socket.c: "sim:ADDR", the virtual board */
+
+/* Is spec well formed (a known name, an argument its backend takes)?  Opens
+ * nothing, so a command can reject it before it prints anything.  0, or -1
+ * with err set as cbvh_backend_open would set it. */
+int cbvh_backend_spec_check(const char *spec, char *err, size_t errlen);
 
 /* Opens by spec: "auto", "model", "usb[:SERIAL]", "hid[:SERIAL]", "sim:ADDR"
  * ("model:ARG" is refused).  For auto, writes one line to log when no board

@@ -9,6 +9,13 @@ static int model_open(cbvh_backend *b, const char *arg, char *err, size_t errlen
     return CBVH_BACKEND_OK;
 }
 
+/* An ignored argument would hide a typo. */
+static int model_check_arg(const char *arg, char *err, size_t errlen) {
+    if (!arg) return 0;
+    snprintf(err, errlen, "the model backend takes no argument (got 'model:%.100s'; use 'model')", arg);
+    return CBVH_BACKEND_BAD_INPUT;
+}
+
 static void model_close(cbvh_backend *b) { (void)b; }
 
 static int model_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_config *cfg, const uint32_t *in,
@@ -22,4 +29,4 @@ static int model_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_con
     return CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_model = {"model", model_open, model_close, model_run};
+const cbvh_backend_ops cbvh_backend_model = {"model", model_check_arg, model_open, model_close, model_run};

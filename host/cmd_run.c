@@ -14,8 +14,8 @@
 
 #include <cjson/cJSON.h>
 
+#include "backend.h"
 #include "cbvh/oom.h"
-#include "cbvh_sim.h"
 #include "commands.h"
 #include "effects.h"
 #include "scene_file.h"
@@ -27,37 +27,6 @@
  * not what the help promises.  Explicit paths stay relative to the cwd. */
 #define DEFAULT_VECTORS CBVH_SOURCE_DIR "/vectors"
 #define DEFAULT_SCENE CBVH_SOURCE_DIR "/scenes/bunny.scene"
-
-/* --backend's form (the names of backend.c, a sim address's syntax), checked
- * before anything is printed; opening it is left to the vector check.  0, or
- * -1 with err set as the check would word it. */
-static int check_backend_spec(const char *spec, char *err, size_t errlen) {
-    size_t n = strcspn(spec, ":");
-    const char *arg = spec[n] == ':' ? spec + n + 1 : NULL;
-    static const char *const names[] = {"model", "usb", "hid", "sim"};
-    int known = strcmp(spec, "auto") == 0;
-    for (size_t i = 0; !known && i < sizeof names / sizeof names[0]; i++)
-        known = strlen(names[i]) == n && strncmp(names[i], spec, n) == 0;
-    int sim = known && n == 3 && strncmp(spec, "sim", 3) == 0;
-    char why[400];
-    if (!known)
-        snprintf(why, sizeof why, "unknown backend '%.100s' (expected auto, model, usb, hid or sim:ADDR)", spec);
-    else if (sim && (!arg || !*arg))
-        snprintf(why, sizeof why, "sim backend needs an address: sim:unix:PATH or sim:tcp:HOST:PORT");
-    else if (!sim || cbvh_sim_addr_check(arg, why, sizeof why) == 0)
-        return 0;
-    snprintf(err, errlen, "backend '%.100s': %s", spec, why);
-    return -1;
-}
-
-/* " x1.234"; where the float BVH's value is 0: " -" if this one's is too (0/0
- * is no ratio), " x inf" if not (as cbvh trace and sweep print them). */
-static void print_x(double a, double b, int prec) {
-    if (b > 0)
-        printf(" x%.*f", prec, a / b);
-    else
-        printf(" %*s", prec + 3, a > 0 ? "x inf" : "-"); /* as wide as " x1.000" */
-}
 
 static void usage(FILE *f) {
     fprintf(f,
@@ -146,8 +115,9 @@ int cmd_run(int argc, char **argv) {
     /* Options first, then the scene (a typo in --scene is reported at once,
      * not after a whole vector check on a board): nothing is printed before. */
     struct stat vst;
-    if (check_backend_spec(backend, err, sizeof err)) {
-        fprintf(stderr, "cbvh run: %s\n", err);
+    char why[400];
+    if (cbvh_backend_spec_check(backend, why, sizeof why)) { /* worded as the vector check would */
+        fprintf(stderr, "cbvh run: backend '%.100s': %s\n", backend, why);
         return 2;
     }
     if (stat(vec_dir, &vst) != 0) {
@@ -241,12 +211,12 @@ int cmd_run(int argc, char **argv) {
                    w->box, w->tri, w->bytes, w->model_ns, w->cpu_us);
             if (w->bits) {
                 printf("  ");
-                print_x((double)w->node_bytes, (double)f->node_bytes, 3);
-                print_x(w->box, f->box, 3);
-                print_x(w->tri, f->tri, 3);
-                print_x(w->bytes, f->bytes, 3);
-                print_x(w->model_ns, f->model_ns, 3);
-                print_x(w->cpu_us, f->cpu_us, 2);
+                cbvh_print_x(cbvh_ratio((double)w->node_bytes, (double)f->node_bytes), 3);
+                cbvh_print_x(cbvh_ratio(w->box, f->box), 3);
+                cbvh_print_x(cbvh_ratio(w->tri, f->tri), 3);
+                cbvh_print_x(cbvh_ratio(w->bytes, f->bytes), 3);
+                cbvh_print_x(cbvh_ratio(w->model_ns, f->model_ns), 3);
+                cbvh_print_x(cbvh_ratio(w->cpu_us, f->cpu_us), 2);
             }
             printf("\n");
         }

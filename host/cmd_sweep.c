@@ -197,9 +197,6 @@ static void default_out(const char *scene, char *out, size_t n) {
     snprintf(out, n, "sweep-%.*s", (int)len, b);
 }
 
-/* a relative to the float BVH's b.  The float BVH did none (b = 0): NaN when
- * neither did (0/0 is no ratio, not 1), infinity when only a did some. */
-static double rel(double a, double b) { return b > 0 ? a / b : a > 0 ? INFINITY : NAN; }
 
 static const char *metric_names[SWEEP_NMETRICS] = {"box tests", "triangle tests", "bytes", "modelled time",
                                                   "CPU time"};
@@ -240,12 +237,12 @@ static void text_row(const char *setting, const char *effect, const cbvh_fx_stat
     cbvh_sweep_per_ray(f, tp, q);
     printf("%-28s %-17s %8llu %8.2f %7.2f %8.1f %9.1f %7.2f |", setting, effect, (unsigned long long)s->rays,
            p[SWEEP_BOX], p[SWEEP_TRI], p[SWEEP_BYTES], p[SWEEP_MODEL_NS], p[SWEEP_CPU_US]);
-    print_rel(rel(p[SWEEP_BOX], q[SWEEP_BOX]));
-    print_rel(rel(p[SWEEP_TRI], q[SWEEP_TRI]));
-    print_rel(rel(p[SWEEP_BYTES], q[SWEEP_BYTES]));
-    print_rel(rel((double)mem, (double)fmem));
-    print_rel(rel(p[SWEEP_MODEL_NS], q[SWEEP_MODEL_NS]));
-    print_rel(rel(p[SWEEP_CPU_US], q[SWEEP_CPU_US]));
+    print_rel(cbvh_ratio(p[SWEEP_BOX], q[SWEEP_BOX]));
+    print_rel(cbvh_ratio(p[SWEEP_TRI], q[SWEEP_TRI]));
+    print_rel(cbvh_ratio(p[SWEEP_BYTES], q[SWEEP_BYTES]));
+    print_rel(cbvh_ratio((double)mem, (double)fmem));
+    print_rel(cbvh_ratio(p[SWEEP_MODEL_NS], q[SWEEP_MODEL_NS]));
+    print_rel(cbvh_ratio(p[SWEEP_CPU_US], q[SWEEP_CPU_US]));
     printf("  %s\n", same);
 }
 
@@ -261,8 +258,8 @@ static cJSON *json_costs(const cbvh_fx_stats *s, const cbvh_fx_stats *f, uint64_
     for (int m = 0; m < SWEEP_NMETRICS; m++) cJSON_AddNumberToObject(o, metric_keys[m], p[m]);
     cJSON *r = cJSON_AddObjectToObject(o, "relative_to_float");
     static const char *rk[SWEEP_NMETRICS] = {"box_tests", "tri_tests", "bytes", "model_time", "cpu_time"};
-    for (int m = 0; m < SWEEP_NMETRICS; m++) json_rel(r, rk[m], rel(p[m], q[m]));
-    json_rel(r, "node_memory", rel((double)mem, (double)fmem));
+    for (int m = 0; m < SWEEP_NMETRICS; m++) json_rel(r, rk[m], cbvh_ratio(p[m], q[m]));
+    json_rel(r, "node_memory", cbvh_ratio((double)mem, (double)fmem));
     return o;
 }
 
@@ -572,7 +569,7 @@ int cmd_sweep(int argc, char **argv) {
         cbvh_fx_stats t = cbvh_fx_total(&res.rows[i].r);
         double p[SWEEP_NMETRICS];
         cbvh_sweep_per_ray(&t, &tp, p);
-        for (int m = 0; m < SWEEP_NMETRICS; m++) relv[(size_t)m * res.nrows + i] = rel(p[m], fq[m]);
+        for (int m = 0; m < SWEEP_NMETRICS; m++) relv[(size_t)m * res.nrows + i] = cbvh_ratio(p[m], fq[m]);
     }
     /* knee[c][m] for the four modelled metrics (CPU time is noisy: not a knee). */
     int knee[CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];

@@ -84,7 +84,6 @@ static per_ray summarize(const cbvh_fx_stats *s, const cbvh_timing_params *tp) {
  * and bytes that are not UTF-8). */
 static void json_str(const char *s) { cbvh_json_str(s, stdout); }
 
-static double ratio(double a, double b) { return b > 0 ? a / b : 0; }
 
 
 static void print_row(const char *name, const char *kind, const per_ray *p, const per_ray *f) {
@@ -94,12 +93,7 @@ static void print_row(const char *name, const char *kind, const per_ray *p, cons
         double a[5] = {p->box, p->tri, p->bytes, p->model_ns, p->cpu_us}, b[5] = {f->box, f->tri, f->bytes,
                                                                                     f->model_ns, f->cpu_us};
         printf("  ");
-        for (int i = 0; i < 5; i++) {
-            if (b[i] > 0)
-                printf(" x%.3f", a[i] / b[i]);
-            else
-                printf(" %6s", a[i] > 0 ? "x inf" : "-"); /* the float BVH did none */
-        }
+        for (int i = 0; i < 5; i++) cbvh_print_x(cbvh_ratio(a[i], b[i]), 3);
     }
     printf("\n");
 }
@@ -281,15 +275,15 @@ int cmd_trace(int argc, char **argv) {
         if (fmt == CBVH_FORMAT_CBVH)
             printf("format cbvh: N=%d, M=%d, min scale %d, modulo; node memory %llu B (float BVH %llu B, x%.3f)\n", bits,
                    mant, min_scale, (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
-                   ratio((double)rc.node_bytes, (double)rf.node_bytes));
+                   cbvh_ratio((double)rc.node_bytes, (double)rf.node_bytes));
         else if (fmt == CBVH_FORMAT_QBVH)
             printf("format qbvh: 4-ary, compressed 32-bit stack, M=%d; node memory %llu B (float BVH %llu B, x%.3f)\n",
                    mant, (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
-                   ratio((double)rc.node_bytes, (double)rf.node_bytes));
+                   cbvh_ratio((double)rc.node_bytes, (double)rf.node_bytes));
         else if (fmt == CBVH_FORMAT_TLIST)
             printf("format %s: sphere hierarchy + lists; list memory %llu B (float BVH %llu B, x%.3f)\n", tlname,
                    (unsigned long long)rc.node_bytes, (unsigned long long)rf.node_bytes,
-                   ratio((double)rc.node_bytes, (double)rf.node_bytes));
+                   cbvh_ratio((double)rc.node_bytes, (double)rf.node_bytes));
         else
             printf("format float: M=%d; node memory %llu B\n", mant, (unsigned long long)rf.node_bytes);
         if (one_sided) printf("one-sided: triangles count only from their counter-clockwise front side\n");

@@ -4,6 +4,7 @@
 #ifndef CBVH_HOST_COMMANDS_H
 #define CBVH_HOST_COMMANDS_H
 
+#include <math.h>
 #include <stdio.h>
 
 int cmd_vectors(int argc, char **argv); /* cmd_vectors.c: gen | check */
@@ -19,6 +20,20 @@ int cmd_sweep(int argc, char **argv);     /* cmd_sweep.c: accuracy vs time over 
  * opterr = 0): one line naming it, instead of getopt's own message (which
  * names the subcommand as if it were the program) and the whole usage. */
 int cbvh_bad_option(const char *cmd, char **argv, int optind_now); /* main.c; returns 2 */
+
+/* A cost a relative to the float BVH's b.  Where the float BVH did none
+ * (b = 0): NaN when neither did (0/0 is no ratio, not 1), infinity when only
+ * a did some.  run, trace and sweep print and chart ratios through this. */
+static inline double cbvh_ratio(double a, double b) { return b > 0 ? a / b : a > 0 ? INFINITY : NAN; }
+
+/* A ratio column: " x1.234" (prec decimals), else "-" (NaN) or "x inf"
+ * right-aligned to the same width. */
+static inline void cbvh_print_x(double r, int prec) {
+    if (isfinite(r))
+        printf(" x%.*f", prec, r);
+    else
+        printf(" %*s", prec + 3, isnan(r) ? "-" : "x inf");
+}
 
 /* JSON must be UTF-8, but file names are bytes: a byte that does not belong
  * to a well-formed UTF-8 sequence (RFC 3629: no overlong forms, surrogates or

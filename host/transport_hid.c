@@ -145,7 +145,7 @@ static int hid_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_confi
     return cbvh_link_run(&s->link, unit, cfg, in, out, count, err, errlen) ? CBVH_BACKEND_ERROR : CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_hid = {"hid", hid_open_board, hid_close_board, hid_run};
+const cbvh_backend_ops cbvh_backend_hid = {"hid", NULL, hid_open_board, hid_close_board, hid_run};
 
 int cbvh_hid_describe(FILE *out) {
     uint16_t vid, pid;

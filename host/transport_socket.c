@@ -53,14 +53,19 @@ static int sock_reopen(void *ctx, char *err, size_t errlen) {
     return s->fd < 0 ? -1 : 0;
 }
 
-static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) {
+/* A wrong address is reported as such, not as "no board (start one with
+ * ...)" with a hint that would fail the same way. */
+static int sim_check_arg(const char *arg, char *err, size_t errlen) {
     if (!arg || !*arg) {
         snprintf(err, errlen, "sim backend needs an address: sim:unix:PATH or sim:tcp:HOST:PORT");
         return CBVH_BACKEND_BAD_INPUT;
     }
-    /* A wrong address or setting is reported as such, not as "no board
-     * (start one with ...)" with a hint that would fail the same way. */
-    if (cbvh_sim_addr_check(arg, err, errlen)) return CBVH_BACKEND_BAD_INPUT;
+    return cbvh_sim_addr_check(arg, err, errlen) ? CBVH_BACKEND_BAD_INPUT : 0;
+}
+
+static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) {
+    int bad = sim_check_arg(arg, err, errlen);
+    if (bad) return bad;
     sim_state *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
@@ -126,7 +131,7 @@ static int sim_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_confi
     return cbvh_link_run(&s->link, unit, cfg, in, out, count, err, errlen) ? CBVH_BACKEND_ERROR : CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_sim = {"sim", sim_open, sim_close, sim_run};
+const cbvh_backend_ops cbvh_backend_sim = {"sim", sim_check_arg, sim_open, sim_close, sim_run};
 
 void cbvh_sim_set_faults(cbvh_backend *b, cbvh_link_fault *f) {
     if (b->ops == &cbvh_backend_sim && b->state) ((sim_state *)b->state)->faults = f;

@@ -184,7 +184,7 @@ static int usb_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_confi
     return cbvh_link_run(&s->link, unit, cfg, in, out, count, err, errlen) ? CBVH_BACKEND_ERROR : CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_usb = {"usb", usb_open, usb_close, usb_run};
+const cbvh_backend_ops cbvh_backend_usb = {"usb", NULL, usb_open, usb_close, usb_run};
 
 int cbvh_usb_describe(FILE *out) {
     uint16_t vid, pid;

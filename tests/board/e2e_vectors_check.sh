@@ -6,18 +6,8 @@
 set -u
 cbvh=$1
 vec=$2
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/cbvh-vcheck-XXXXXX") || exit 1
-sock=$tmp/board.sock
-"$cbvh" board-sim --listen "unix:$sock" >/dev/null &
-pid=$!
-cleanup() {
-    kill "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
-    rm -rf "$tmp"
-}
-trap cleanup EXIT INT TERM
-i=0
-while [ ! -S "$sock" ] && [ $i -lt 250 ]; do sleep 0.02; i=$((i + 1)); done
-[ -S "$sock" ] || { echo "FAIL: board-sim did not come up"; exit 1; }
+. "$(dirname "$0")/board_sim.sh"
+board_sim_start || { echo "FAIL: board-sim did not come up"; exit 1; }
 
 "$cbvh" vectors check --backend model "$vec" >"$tmp/model.out" 2>&1
 rc_model=$?
@@ -43,11 +33,7 @@ echo "PASS: sim and model agree"
 
 # The check must be able to fail: a board whose axis_compress flips one output
 # bit (a gateware bug) must fail exactly the axis_compress vectors.
-kill "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
-"$cbvh" board-sim --listen "unix:$sock" --break-unit axis_compress >/dev/null &
-pid=$!
-i=0
-while [ ! -S "$sock" ] && [ $i -lt 250 ]; do sleep 0.02; i=$((i + 1)); done
+board_sim_start --break-unit axis_compress || { echo "FAIL: the broken board-sim did not come up"; exit 1; }
 "$cbvh" vectors check --backend "sim:unix:$sock" "$vec" >"$tmp/broken.out" 2>&1
 rc_broken=$?
 [ "$rc_broken" = 1 ] || { echo "FAIL: a broken board gave exit $rc_broken, want 1"; tail -3 "$tmp/broken.out"; exit 1; }

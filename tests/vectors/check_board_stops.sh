@@ -11,18 +11,8 @@ cbvh=$1
 file=$2/axis_decode-N6-ms-30-modulo.vec # 1878 vectors, vector 0 on line 13
 first_line=13
 count=1878
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/cbvh-stops-XXXXXX") || exit 1
-sock=$tmp/board.sock
-"$cbvh" board-sim --listen "unix:$sock" >/dev/null &
-pid=$!
-cleanup() {
-    kill "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
-    rm -rf "$tmp"
-}
-trap cleanup EXIT INT TERM
-i=0
-while [ ! -S "$sock" ] && [ $i -lt 250 ]; do sleep 0.02; i=$((i + 1)); done
-[ -S "$sock" ] || { echo "SKIP: board-sim did not come up"; exit 77; }
+. "$(dirname "$0")/../board/board_sim.sh"
+board_sim_start || { echo "SKIP: board-sim did not come up"; exit 77; }
 
 # $1: extra options; $2: lowest first index that proves file numbering (the
 # first vector of the second batch); $3: "sampled" when --sample is given.
