@@ -21,7 +21,15 @@
  * (cbvh_build_lbvh_streaming: the same LBVH with the compression inside its
  * bottom-up pass, same output bits, timed right after the LBVH alone),
  * fused/lbvh the ratio of the bests and fused_med the median over
- * repetitions of fused / LBVH with both from the same repetition. */
+ * repetitions of fused / LBVH with both from the same repetition.
+ * arith_ms: the bare arithmetic of Algorithm 1's per-pair step alone, on
+ * the LBVH's own nodes packed beforehand (untimed): each inner node's three
+ * scale estimates and context codes and its leaf children's six floors,
+ * through the units' inline fast paths (rtl-model/src/unit_fast.h) -- no
+ * stack, no records, no packing, no backtracking, no inner children.  Any
+ * scalar step built on these fast paths does at least that, so
+ * min_fused = 1 + arith_ms / lbvh_ms (bests) is a floor under fused/lbvh
+ * (docs/results.md, "A floor under the fused build"). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <limits.h>
@@ -36,6 +44,7 @@
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
 #include "scene_load.h"
+#include "unit_fast.h"
 
 #ifndef CBVH_SCENES_DIR
 #define CBVH_SCENES_DIR "scenes"
@@ -55,6 +64,59 @@ static int cmp_double(const void *a, const void *b) {
 static void die(const char *what, const char *err) {
     fprintf(stderr, "bench_build: %s: %s\n", what, err);
     exit(1);
+}
+
+/* One inner node's inputs to the step, as binary32 bit patterns. */
+typedef struct {
+    cbvh_f32 box[6];     /* lo[3], hi[3] */
+    cbvh_f32 leaf[2][6]; /* its leaf children's boxes, nleaf of them */
+    uint32_t nleaf;
+} arith_rec;
+
+static size_t arith_pack(const cbvh_bvh *b, arith_rec *r) {
+    size_t n = 0;
+    for (uint32_t x = 0; x < b->nnodes; x++) {
+        const cbvh_bvh_node *nd = &b->nodes[x];
+        if (cbvh_bvh_is_leaf(nd)) continue;
+        arith_rec *q = &r[n++];
+        q->nleaf = 0;
+        for (int a = 0; a < 3; a++) q->box[a] = cbvh_f32_of(nd->lo[a]), q->box[3 + a] = cbvh_f32_of(nd->hi[a]);
+        for (int c = 0; c < 2; c++) {
+            const cbvh_bvh_node *cn = &b->nodes[nd->child[c]];
+            if (!cbvh_bvh_is_leaf(cn)) continue;
+            for (int a = 0; a < 3; a++)
+                q->leaf[q->nleaf][a] = cbvh_f32_of(cn->lo[a]), q->leaf[q->nleaf][3 + a] = cbvh_f32_of(cn->hi[a]);
+            q->nleaf++;
+        }
+    }
+    return n;
+}
+
+static volatile uint64_t arith_sink;
+
+/* The arithmetic every step does (see the header).  Returns how many
+ * inputs left the fast paths (they would take the units' general paths). */
+static uint64_t arith_step(const arith_rec *r, size_t n, int nq, int ms) {
+    uint64_t sum = 0, slow = 0;
+    for (size_t i = 0; i < n; i++) {
+        int cs[3];
+        for (int a = 0; a < 3; a++) {
+            int e = 0;
+            int64_t k = 0, ku = 0;
+            uint32_t lm = 0, um = 0;
+            slow += cbvh_scale_estimate_fast_nm(nq, ms, r[i].box[a], r[i].box[3 + a], &e, &k, &ku) != 2;
+            slow += !cbvh_fast_code(nq, ms, e, k, ku, &lm, &um, &cs[a]);
+            sum += lm ^ um;
+        }
+        for (uint32_t c = 0; c < r[i].nleaf; c++)
+            for (int a = 0; a < 3; a++) {
+                int64_t k, ku;
+                slow += !(cbvh_fast_floor(r[i].leaf[c][a], cs[a], &k) & cbvh_fast_floor(r[i].leaf[c][3 + a], cs[a], &ku));
+                sum += (uint64_t)(ku - k);
+            }
+    }
+    arith_sink = sum;
+    return slow;
 }
 
 int main(int argc, char **argv) {
@@ -93,15 +155,16 @@ int main(int argc, char **argv) {
     }
     char err[512];
     if (warm) printf("# --warm: freed memory kept for reuse, one untimed repetition first\n");
-    printf("%-24s %10s %10s %9s %9s %9s %9s %7s %9s %7s %9s %11s %9s %11s %11s %6s\n", "scene", "triangles", "lbvh_ms",
+    printf("%-24s %10s %10s %9s %9s %9s %9s %7s %9s %7s %9s %11s %9s %11s %11s %6s %9s %9s\n", "scene", "triangles", "lbvh_ms",
            "Mtri/s", "lbvh+bu", "bu_ms", "lbvh+td", "bu/lbvh", "run_ratio", "td/lbvh", "fused_ms", "fused/lbvh",
-           "fused_med", "cbvh_bytes", "float_bytes", "ratio");
+           "fused_med", "cbvh_bytes", "float_bytes", "ratio", "arith_ms", "min_fused");
     for (int i = 0; i < ns; i++) {
         cbvh_scene s;
         if (cbvh_scene_open(specs[i], &s, err, sizeof err)) die(specs[i], err);
         cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 4, 0};
         double best_l = 1e30, best_bu = 1e30, best_td = 1e30, best_c = 1e30, best_run = 1e30, best_f = 1e30,
-               fr[100] = {0};
+               fr[100] = {0}, best_a = 1e30;
+        uint64_t slow = 0;
         size_t cb = 0, fb = 0;
         for (int r = -warm; r < reps; r++) { /* r < 0: the untimed warm-up */
             cbvh_bvh b;
@@ -111,6 +174,15 @@ int main(int argc, char **argv) {
             double t0 = now();
             if (cbvh_build_lbvh(&s, &b, err, sizeof err)) die(specs[i], err);
             double t1 = now();
+            /* the step's bare arithmetic on this LBVH's nodes */
+            arith_rec *ar = malloc((size_t)b.nnodes * sizeof *ar);
+            if (!ar) die(specs[i], "out of memory for the arithmetic floor");
+            size_t nar = arith_pack(&b, ar);
+            double ta0 = now();
+            slow = arith_step(ar, nar, o.params.quant_bits, o.params.min_scale);
+            double ta1 = now();
+            free(ar);
+            if (r >= 0 && ta1 - ta0 < best_a) best_a = ta1 - ta0;
             cbvh_bvh_free(&b);
             /* fused LBVH + streaming compression, right after the LBVH alone
              * so that the pair sees the same machine load */
@@ -149,10 +221,13 @@ int main(int argc, char **argv) {
         }
         qsort(fr, (size_t)reps, sizeof fr[0], cmp_double);
         double fused_med = reps % 2 ? fr[reps / 2] : 0.5 * (fr[reps / 2 - 1] + fr[reps / 2]);
-        printf("%-24.24s %10u %10.2f %9.2f %9.2f %9.2f %9.2f %7.2f %9.2f %7.2f %9.2f %11.2f %9.2f %11zu %11zu %6.3f\n",
+        printf("%-24.24s %10u %10.2f %9.2f %9.2f %9.2f %9.2f %7.2f %9.2f %7.2f %9.2f %11.2f %9.2f %11zu %11zu %6.3f %9.2f %9.2f\n",
                s.name, s.ntris, 1e3 * best_l, s.ntris / best_l / 1e6, 1e3 * best_bu, 1e3 * best_c, 1e3 * best_td,
                best_bu / best_l, best_run, best_td / best_l, 1e3 * best_f, best_f / best_l, fused_med, cb, fb,
-               (double)cb / (double)fb);
+               (double)cb / (double)fb, 1e3 * best_a, 1.0 + best_a / best_l);
+        if (slow)
+            printf("# %s: %llu inputs left the fast paths (the general paths, slower, are not timed)\n", s.name,
+                   (unsigned long long)slow);
         fflush(stdout);
         cbvh_scene_free(&s);
     }
