@@ -2,7 +2,7 @@
  * build vs the float LBVH build in the same run, top-down compression, and
  * CBVH bytes vs float BVH bytes.
  *
- * usage: bench_build [--reps R] [--warm] [SCENE...]
+ * usage: bench_build [--reps R] [--warm] [--json FILE] [SCENE...]
  *   SCENE as for `cbvh study` (file or proc:NAME[:SIZE]); default: the bundled
  *   bunny and proc:instanced (10.24 M triangles).
  *   --warm: glibc keeps freed memory (no mmap for large blocks, no trimming)
@@ -11,6 +11,8 @@
  *   a VM whose host backs a page at first touch that cost (measured up to
  *   ~12 us per 4 KiB page) lands in both sides of every ratio
  *   (docs/results.md, "Fused LBVH + streaming compression").
+ *   --json FILE: the same figures for machines, written to FILE (temporary
+ *   file, then renamed, so a failed run leaves no half-written FILE).
  * Times are the best of R repetitions (default 3), one core.  Both sides of
  * the ratio build the LBVH the same way (Morton codes, sort and all): the
  * float build alone, and the float build followed by the streaming
@@ -40,6 +42,8 @@
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
+
+#include <cjson/cJSON.h>
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
@@ -121,7 +125,7 @@ static uint64_t arith_step(const arith_rec *r, size_t n, int nq, int ms) {
 
 int main(int argc, char **argv) {
     int reps = 3, warm = 0;
-    const char *specs[64];
+    const char *specs[64], *json = NULL;
     int ns = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
@@ -136,8 +140,10 @@ int main(int argc, char **argv) {
 #else
             die("--warm", "needs glibc's mallopt");
 #endif
+        } else if (!strcmp(argv[i], "--json") && i + 1 < argc) {
+            json = argv[++i];
         } else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: bench_build [--reps R] [--warm] [SCENE...]\n");
+            fprintf(stderr, "usage: bench_build [--reps R] [--warm] [--json FILE] [SCENE...]\n");
             return 2;
         } else if (ns < 64) {
             specs[ns++] = argv[i];
@@ -154,6 +160,13 @@ int main(int argc, char **argv) {
         specs[ns++] = "proc:instanced";
     }
     char err[512];
+    cJSON *jroot = cJSON_CreateObject(), *jscenes = cJSON_AddArrayToObject(jroot, "scenes");
+    if (!jroot || !jscenes) die("--json", "out of memory");
+    cJSON_AddNumberToObject(jroot, "reps", reps);
+    cJSON_AddBoolToObject(jroot, "warm", warm);
+    cJSON_AddNumberToObject(jroot, "quant_bits", 6);
+    cJSON_AddStringToObject(jroot, "encoding", "modulo");
+    cJSON_AddNumberToObject(jroot, "treelet_depth", 4);
     if (warm) printf("# --warm: freed memory kept for reuse, one untimed repetition first\n");
     printf("%-24s %10s %10s %9s %9s %9s %9s %7s %9s %7s %9s %11s %9s %11s %11s %6s %9s %9s\n", "scene", "triangles", "lbvh_ms",
            "Mtri/s", "lbvh+bu", "bu_ms", "lbvh+td", "bu/lbvh", "run_ratio", "td/lbvh", "fused_ms", "fused/lbvh",
@@ -225,11 +238,43 @@ int main(int argc, char **argv) {
                s.name, s.ntris, 1e3 * best_l, s.ntris / best_l / 1e6, 1e3 * best_bu, 1e3 * best_c, 1e3 * best_td,
                best_bu / best_l, best_run, best_td / best_l, 1e3 * best_f, best_f / best_l, fused_med, cb, fb,
                (double)cb / (double)fb, 1e3 * best_a, 1.0 + best_a / best_l);
+        cJSON *js = cJSON_CreateObject();
+        cJSON_AddItemToArray(jscenes, js);
+        cJSON_AddStringToObject(js, "scene", s.name);
+        cJSON_AddNumberToObject(js, "triangles", s.ntris);
+        cJSON_AddNumberToObject(js, "lbvh_ms", 1e3 * best_l);
+        cJSON_AddNumberToObject(js, "lbvh_mtri_per_s", s.ntris / best_l / 1e6);
+        cJSON_AddNumberToObject(js, "lbvh_bu_ms", 1e3 * best_bu);
+        cJSON_AddNumberToObject(js, "bu_ms", 1e3 * best_c);
+        cJSON_AddNumberToObject(js, "lbvh_td_ms", 1e3 * best_td);
+        cJSON_AddNumberToObject(js, "bu_over_lbvh", best_bu / best_l);
+        cJSON_AddNumberToObject(js, "run_ratio", best_run);
+        cJSON_AddNumberToObject(js, "td_over_lbvh", best_td / best_l);
+        cJSON_AddNumberToObject(js, "fused_ms", 1e3 * best_f);
+        cJSON_AddNumberToObject(js, "fused_over_lbvh", best_f / best_l);
+        cJSON_AddNumberToObject(js, "fused_median", fused_med);
+        cJSON_AddNumberToObject(js, "cbvh_bytes", (double)cb);
+        cJSON_AddNumberToObject(js, "float_bytes", (double)fb);
+        cJSON_AddNumberToObject(js, "bytes_ratio", (double)cb / (double)fb);
+        cJSON_AddNumberToObject(js, "arith_ms", 1e3 * best_a);
+        cJSON_AddNumberToObject(js, "min_fused", 1.0 + best_a / best_l);
+        cJSON_AddNumberToObject(js, "arith_slow_inputs", (double)slow);
         if (slow)
             printf("# %s: %llu inputs left the fast paths (the general paths, slower, are not timed)\n", s.name,
                    (unsigned long long)slow);
         fflush(stdout);
         cbvh_scene_free(&s);
     }
+    if (json) {
+        char *txt = cJSON_Print(jroot), tmp[4096];
+        snprintf(tmp, sizeof tmp, "%s.tmp", json);
+        FILE *f = fopen(tmp, "w");
+        if (!f || !txt || fputs(txt, f) < 0 || fclose(f) != 0 || rename(tmp, json) != 0) {
+            remove(tmp);
+            die(json, "cannot write the JSON file");
+        }
+        free(txt);
+    }
+    cJSON_Delete(jroot);
     return 0;
 }
