@@ -31,6 +31,7 @@
 
 #include "cbvh/tlist.h"
 #define BENCH_NAME "bench_tlist"
+#include "bench_json.h"
 #include "bench_rays.h"
 
 #define CELL 8
@@ -359,16 +360,7 @@ int main(int argc, char **argv) {
     }
     printf("\npaper (GTX 280, bunny 69k tris): 6 lists beat 1 by 5-15 %%; optimisations change nodes/ray by up to "
            "19.8 %% (Table 1); fps flat (memory bound)\n");
-    if (json) {
-        char *txt = cJSON_Print(jroot), tmp[4096];
-        snprintf(tmp, sizeof tmp, "%s.tmp", json);
-        FILE *f = fopen(tmp, "w");
-        if (!f || !txt || fputs(txt, f) < 0 || fclose(f) != 0 || rename(tmp, json) != 0) {
-            remove(tmp);
-            die(json, "cannot write the JSON file");
-        }
-        free(txt);
-    }
+    if (json && bench_json_write(jroot, json)) die(json, "cannot write the JSON file");
     cJSON_Delete(jroot);
     return 0;
 }
