@@ -27,7 +27,7 @@
  * arith_ms: the bare arithmetic of Algorithm 1's per-pair step alone, on
  * the LBVH's own nodes packed beforehand (untimed): each inner node's three
  * scale estimates and context codes and its leaf children's six floors,
- * through the units' inline fast paths (rtl-model/src/unit_fast.h) -- no
+ * through the units' inline fast paths (rtl-model/src/fast/unit_fast.h) -- no
  * stack, no records, no packing, no backtracking, no inner children.  Any
  * scalar step built on these fast paths does at least that, so
  * min_fused = 1 + arith_ms / lbvh_ms (bests) is a floor under fused/lbvh
@@ -48,8 +48,8 @@
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
 #include "bench_json.h"
-#include "scene_load.h"
-#include "unit_fast.h"
+#include "scene/scene_load.h"
+#include "fast/unit_fast.h"
 
 #ifndef CBVH_SCENES_DIR
 #define CBVH_SCENES_DIR "scenes"

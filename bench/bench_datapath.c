@@ -20,7 +20,7 @@
 #include "cbvh/datapath.h"
 #include "cbvh/traversal_units.h"
 
-/* The ray-sphere unit's exact path alone (rtl-model/src/ray_sphere_internal.h). */
+/* The ray-sphere unit's exact path alone (rtl-model/src/units/ray_sphere_internal.h). */
 uint32_t cbvh_ray_sphere_exact_only(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r, int *hit);
 
 #define NB 4096 /* boxes per input set (power of two) */

@@ -17,7 +17,7 @@
 #include <time.h>
 
 #include "cbvh/traverse.h"
-#include "scene_load.h"
+#include "scene/scene_load.h"
 #include "test_util.h" /* fb, bf, xorshift64 (tests/common) */
 
 #ifndef BENCH_NAME

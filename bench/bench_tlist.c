@@ -11,7 +11,7 @@
  * the float BVH's (triangle and t bits); a mismatch aborts.
  *
  * Rays: bench_rays.h (half pinhole-camera rays, half random rays), plus one
- * secondary ray per front hit of a camera ray made as host/effects.c makes
+ * secondary ray per front hit of a camera ray made as host/trace/effects.c makes
  * them (origin fl(o + t d) + eps n, direction uniform in the front
  * hemisphere).  Heads "cell": camera rays start at their 8x8-pixel cell's
  * head (cbvh_tlist_cell_heads, the paper's frustum culling); "poly":
@@ -42,7 +42,7 @@ typedef struct {
     int kind;      /* 0 camera, 1 random, 2 secondary */
 } bray;
 
-/* Secondary rays from the front hits of the camera rays (host/effects.c). */
+/* Secondary rays from the front hits of the camera rays (host/trace/effects.c). */
 static int make_secondary(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_ray *cam, int ncam, float eps, bray *out) {
     int k = 0;
     for (int i = 0; i < ncam; i++) {

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "protocol.h"
+#include "link/protocol.h"
 
 typedef struct {
     const uint8_t *p;

@@ -1,4 +1,4 @@
-/* libFuzzer: the vector set's MANIFEST reader (host/manifest.h).  An accepted
+/* libFuzzer: the vector set's MANIFEST reader (host/vectors/manifest.h).  An accepted
  * manifest holds only well-formed entries (a plain printable file name, 64
  * lower-case hex digits), each findable by its name; every rejection names
  * its reason on one line. */
@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "manifest.h"
+#include "vectors/manifest.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cbvh_manifest m;

@@ -1,4 +1,4 @@
-/* libFuzzer: mesh import (host/scene_import.c: the OFF and PLY checks, then
+/* libFuzzer: mesh import (host/scene/scene_import.c: the OFF and PLY checks, then
  * assimp).  The first byte picks the extension (OFF, PLY, OBJ, STL, glTF),
  * the rest is the file.  Every input must give either a scene of finite triangles or
  * a one-line error naming the problem; never a crash. */
@@ -9,7 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "scene_load.h"
+#include "scene/scene_load.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     static const char *const ext[] = {"off", "ply", "obj", "stl", "gltf"};

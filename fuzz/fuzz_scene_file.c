@@ -1,4 +1,4 @@
-/* libFuzzer: scene files (host/scene_file.c, docs/scenes.md).  An input that
+/* libFuzzer: scene files (host/scene/scene_file.c, docs/scenes.md).  An input that
  * is a JSON object gets its "mesh" replaced by a small procedural scene (so
  * no mesh file is read and no 10M-triangle scene built); every other field
  * is the fuzzer's.  Every input must give a scene description or a one-line
@@ -9,7 +9,7 @@
 
 #include <cjson/cJSON.h>
 
-#include "scene_file.h"
+#include "scene/scene_file.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char *text = malloc(size + 1);

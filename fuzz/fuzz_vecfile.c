@@ -1,8 +1,8 @@
-/* libFuzzer: the golden-vector file reader (host/vecfile.h). */
+/* libFuzzer: the golden-vector file reader (host/vectors/vecfile.h). */
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "vecfile.h"
+#include "vectors/vecfile.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cbvh_vecfile vf;

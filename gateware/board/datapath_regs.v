@@ -78,7 +78,7 @@ module cbvh_datapath_regs #(
     localparam [31:0] UNITS_MASK = (B1 << 1) | (B2 << 2) | (B3 << 3) | (B4 << 4) |
                                    (B5 << 5) | (B6 << 6) | (B7 << 7) | (B8 << 8) | (B9 << 9);
 
-    // shapes (rtl-model/src/unit_table.c): input and output words per unit
+    // shapes (rtl-model/src/units/unit_table.c): input and output words per unit
     localparam integer NIN1 = 2,  NOUT1 = 2;
     localparam integer NIN2 = 3,  NOUT2 = 6;
     localparam integer NIN3 = 6,  NOUT3 = 6;

@@ -15,8 +15,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "backend.h"
-#include "board_link.h"
+#include "link/backend.h"
+#include "link/board_link.h"
 #include "cbvh_sim.h"
 #include "gen_inputs.h"
 

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "board_link.h"
+#include "link/board_link.h"
 #include "cbvh_sim.h"
 #include "gen_inputs.h"
 

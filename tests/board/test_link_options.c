@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "board_link.h"
+#include "link/board_link.h"
 #include "cbvh_sim.h"
 #include "test_util.h"
 

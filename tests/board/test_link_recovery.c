@@ -16,7 +16,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "board_link.h"
+#include "link/board_link.h"
 #include "cbvh_sim.h"
 #include "gen_inputs.h"
 #include "test_util.h"

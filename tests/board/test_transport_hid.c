@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "board_link.h"
+#include "link/board_link.h"
 #include "cbvh_sim.h"
 #include "gen_inputs.h"
 #include "test_util.h"

@@ -17,7 +17,7 @@
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
 #include "test_util.h"
-#include "scene_load.h"
+#include "scene/scene_load.h"
 
 #ifndef CBVH_SCENES_DIR
 #error "CBVH_SCENES_DIR must name the scenes folder"

@@ -17,8 +17,8 @@
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
 #include "test_util.h"
-#include "scene_load.h"
-#include "../../rtl-model/src/cbvh_layout.h"
+#include "scene/scene_load.h"
+#include "build/cbvh_layout.h"
 
 #ifndef CBVH_SCENES_DIR
 #error "CBVH_SCENES_DIR must name the scenes folder"

@@ -16,7 +16,7 @@
 
 #include <cmocka.h>
 
-#include "scene_load.h"
+#include "scene/scene_load.h"
 
 #define BIG 300000000LL /* the sparse .bin: 300 s of limit */
 

@@ -18,7 +18,7 @@
 #include "cbvh/cbvh_tree.h"
 #include "cbvh/qbvh.h"
 #include "cbvh/tlist.h"
-#include "scene_load.h"
+#include "scene/scene_load.h"
 #include "test_util.h"
 
 #ifndef CBVH_SCENES_DIR

@@ -1,4 +1,4 @@
-/* The constant-time scale estimator (rtl-model/src/scale_estimator.c) against
+/* The constant-time scale estimator (rtl-model/src/units/scale_estimator.c) against
  * the binary search over [min_scale, 126] it replaced, kept here verbatim as
  * the oracle (same fit predicate, built from grid.h), and against an FPU
  * check of the fit predicate at the result and one below.  Status and scale
@@ -8,7 +8,7 @@
  * NaN/Inf and inverted boxes.
  *
  * usage: test_estimator_fast [--scale S]   (S multiplies the random counts) */
-#include "grid.h"
+#include "units/grid.h"
 #include "prop_util.h"
 
 /* ---- the oracle: the previous model, verbatim ---- */

@@ -1,4 +1,4 @@
-/* The inline fast paths of rtl-model/src/unit_fast.h (used by the streaming
+/* The inline fast paths of rtl-model/src/fast/unit_fast.h (used by the streaming
  * bottom-up compressor) against the units and an FPU oracle, and the
  * streaming compressor against the top-down one on hard scenes.
  *
@@ -28,9 +28,9 @@
 
 #include "cbvh/bvh.h"
 #include "cbvh/cbvh_tree.h"
-#include "grid.h"
+#include "units/grid.h"
 #include "prop_util.h"
-#include "unit_fast.h"
+#include "fast/unit_fast.h"
 
 static long n_cases;
 

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "cbvh/qbvh.h"
-#include "scene_load.h"
+#include "scene/scene_load.h"
 #include "test_trav_util.h"
 
 static int fails;

@@ -1,4 +1,4 @@
-/* cbvh sweep core (host/sweep.c, docs/sweep.md): the rows, the relative
+/* cbvh sweep core (host/trace/sweep.c, docs/sweep.md): the rows, the relative
  * costs at the extremes, the ray-by-ray identity check (and that a corrupted
  * setting fails it), the heat-map data and the knee rule; the QBVH row
  * (--formats cbvh,qbvh). */
@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "sweep.h"
+#include "trace/sweep.h"
 
 static cbvh_scene_desc scene;
 static cbvh_sweep_result res; /* bits 3..10 x M {24, 8} x E {-30} */

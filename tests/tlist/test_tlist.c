@@ -24,8 +24,8 @@
 #include <string.h>
 
 #include "cbvh/tlist.h"
-#include "exact_wide.h"
-#include "scene_load.h"
+#include "units/exact_wide.h"
+#include "scene/scene_load.h"
 #include "test_trav_util.h"
 
 static long fails;

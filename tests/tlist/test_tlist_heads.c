@@ -1,6 +1,6 @@
 /* List heads (docs/tlist.md §7).
  *
- * Per-polygon heads: secondary rays made exactly as host/effects.c makes them
+ * Per-polygon heads: secondary rays made exactly as host/trace/effects.c makes them
  * (front hit of a one-sided camera/random ray, hit point fl(o + t d), origin
  * offset by eps along the unit normal, directions in the front hemisphere,
  * mirror directions, shadow rays to points with bounded tmax), started at
@@ -23,7 +23,7 @@
 #include <string.h>
 
 #include "cbvh/tlist.h"
-#include "scene_load.h"
+#include "scene/scene_load.h"
 #include "test_trav_util.h"
 
 static long fails;
@@ -107,7 +107,7 @@ static float coord_max(const cbvh_scene *s) {
 }
 
 /* Camera or random incoming ray; on a front hit, secondary rays as in
- * host/effects.c (shade: q = p + eps * n). */
+ * host/trace/effects.c (shade: q = p + eps * n). */
 static void poly_rays(const cbvh_scene *s, const cbvh_bvh *b, const cbvh_tlists *L, int nrays, float eps, tally *T) {
     float lo[3], hi[3], c[3], ext = 0;
     cbvh_scene_bounds(s, lo, hi);
@@ -285,7 +285,7 @@ static void run_scene(const char *spec, int nrays, int W) {
     float lo[3], hi[3];
     cbvh_scene_bounds(&s, lo, hi);
     float dg[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    float eps = 1e-4f * sqrtf(dg[0] * dg[0] + dg[1] * dg[1] + dg[2] * dg[2]); /* host/effects.c */
+    float eps = 1e-4f * sqrtf(dg[0] * dg[0] + dg[1] * dg[1] + dg[2] * dg[2]); /* host/trace/effects.c */
     /* origins of incoming rays reach 2 extents beyond the centre: include them */
     float cm = coord_max(&s) + 3 * sqrtf(dg[0] * dg[0] + dg[1] * dg[1] + dg[2] * dg[2]);
     float margin = cbvh_tlist_hitpoint_margin(eps, cm);

@@ -20,9 +20,9 @@
 
 #include <cmocka.h>
 
-#include "effects.h"
-#include "scene_file.h"
-#include "timing_model.h"
+#include "trace/effects.h"
+#include "scene/scene_file.h"
+#include "trace/timing_model.h"
 
 #define MESH CBVH_SCENES_DIR "/bunny-small.obj"
 #define CAMERA                                                                                                  \

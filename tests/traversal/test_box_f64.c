@@ -1,5 +1,5 @@
 /* The traversal's fast paths (docs/traversal.md §9) against the units:
- *   - the ray-box unit's binary64 filter (rtl-model/src/ray_box_f64.h) on
+ *   - the ray-box unit's binary64 filter (rtl-model/src/fast/ray_box_f64.h) on
  *     float planes and on grid planes u + r 2^e: whenever it decides, hit and
  *     t_near equal the exact path's (cbvh_ray_box_*_exact_only) bit for bit;
  *     the claim that a grid plane is exact in binary64 is checked with an
@@ -7,11 +7,11 @@
  *     one-box version lane by lane, and its variants for valid planes and
  *     for binary32 planes (SSE2 on x86-64) equal it; test_box_f64_plain is
  *     the same test with the two-box lanes in plain C (CBVH_NO_SSE2);
- *   - the node-pair decode for the traversal (rtl-model/src/decode_fast.h):
+ *   - the node-pair decode for the traversal (rtl-model/src/fast/decode_fast.h):
  *     accepts exactly the pairs the unit decodes with status 0 (N = 3..10) and
  *     then gives the same leaf/empty/pointer, relative coordinates and child
  *     contexts as cbvh_nodepair_decode + cbvh_axis_child_ctx;
- *   - the plain float traversals' slab test (rtl-model/src/ray_box_ref.h):
+ *   - the plain float traversals' slab test (rtl-model/src/fast/ray_box_ref.h):
  *     cbvh_ref_box2 (SSE2 lanes on x86-64), the four-box cbvh_ref_box4 and
  *     the eight-box cbvh_ref_box8 equal the plain C cbvh_ref_box2_c bit for
  *     bit on every box (whose conservativeness tests/traversal/test_ray_box.c
@@ -31,10 +31,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../rtl-model/src/decode_fast.h"
-#include "../../rtl-model/src/ray_box_f64.h"
-#include "../../rtl-model/src/ray_box_ref.h"
-#include "../../rtl-model/src/ray_prep.h"
+#include "fast/decode_fast.h"
+#include "fast/ray_box_f64.h"
+#include "fast/ray_box_ref.h"
+#include "fast/ray_prep.h"
 #include "test_util.h"
 
 #ifdef CBVH_SANITIZE

@@ -34,7 +34,7 @@
 #include "cbvh/qbvh.h"
 #include "cbvh/tlist.h"
 #include "cbvh/traverse.h"
-#include "fast_paths.h"
+#include "fast/fast_paths.h"
 #include "test_util.h"
 
 #ifdef CBVH_SANITIZE

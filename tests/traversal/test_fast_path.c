@@ -19,8 +19,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../../rtl-model/src/ray_prep.h"
-#include "../../rtl-model/src/tri_filter_avx.h"
+#include "fast/ray_prep.h"
+#include "fast/tri_filter_avx.h"
 #include "cbvh/traversal_units.h"
 #include "test_util.h"
 

@@ -1,5 +1,5 @@
-/* PNG / heat-map writer (host/image_png.c) and SVG chart writer
- * (host/chart_svg.c): PNG round trip through libpng's reader, heat-map
+/* PNG / heat-map writer (host/util/image_png.c) and SVG chart writer
+ * (host/util/chart_svg.c): PNG round trip through libpng's reader, heat-map
  * colours and legend, SVG well-formedness basics, bad input rejected with
  * nothing left behind. */
 #define _GNU_SOURCE
@@ -16,8 +16,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "chart_svg.h"
-#include "image_png.h"
+#include "util/chart_svg.h"
+#include "util/image_png.h"
 
 static char dir[256];
 

@@ -19,7 +19,7 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
-#include "ray_box_ref.h"
+#include "fast/ray_box_ref.h"
 #include "test_util.h"
 
 #ifdef CBVH_SANITIZE

@@ -19,7 +19,7 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
-#include "ray_sphere_internal.h"
+#include "units/ray_sphere_internal.h"
 #include "test_util.h"
 
 #ifdef CBVH_SANITIZE

@@ -27,7 +27,7 @@
 #include "cbvh/qbvh.h"
 #include "cbvh/traverse.h"
 #include "cbvh/unit_table.h"
-#include "scene_load.h"
+#include "scene/scene_load.h"
 #include "test_trav_util.h"
 #include "test_wide.h"
 

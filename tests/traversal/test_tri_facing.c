@@ -1,4 +1,4 @@
-/* The exact facing predicate (rtl-model/src/tri_facing.c) against a GMP
+/* The exact facing predicate (rtl-model/src/units/tri_facing.c) against a GMP
  * rational oracle, over structured and random inputs, and one-sided traversal
  * (CBVH_TRAV_FRONT_ONLY) against brute force over every triangle. */
 #include <gmp.h>

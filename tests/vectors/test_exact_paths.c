@@ -17,10 +17,10 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
-#include "ray_prep.h"
-#include "ray_sphere_internal.h"
+#include "fast/ray_prep.h"
+#include "units/ray_sphere_internal.h"
 #include "test_util.h"
-#include "vecfile.h"
+#include "vectors/vecfile.h"
 
 static int fails;
 #define CHECK(c, ...) TU_CHECK(fails, stdout, c, __VA_ARGS__)

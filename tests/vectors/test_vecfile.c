@@ -13,10 +13,10 @@
 
 #include <cmocka.h>
 
-#include "manifest.h"
-#include "vecfile.h"
-#include "vecgen.h"
-#include "vectors_check.h"
+#include "vectors/manifest.h"
+#include "vectors/vecfile.h"
+#include "vectors/vecgen.h"
+#include "vectors/vectors_check.h"
 
 #ifndef FIXTURES
 #error FIXTURES must point at tests/vectors/fixtures

@@ -37,7 +37,7 @@ typedef struct {
     int small_planes;          /* every plane's magnitude <= 2^62: the binary32 box lanes may run (§16) */
 } cbvh_f8bvh;
 
-/* Collapse b (rtl-model/src/build_f8bvh.c): each inner record takes up to 8
+/* Collapse b (rtl-model/src/qbvh/build_f8bvh.c): each inner record takes up to 8
  * of b's nodes below it by opening the inner child of largest area (the
  * leftmost of equal ones) until there are 8, as the QBVH's collapse does for
  * 4; leaves and boxes are b's.  0, or -1 with a one-line reason (out of
@@ -50,7 +50,7 @@ int cbvh_f8bvh_build(const cbvh_bvh *b, const cbvh_tri *tris, uint32_t ntris, cb
                      size_t errlen);
 void cbvh_f8bvh_free(cbvh_f8bvh *f);
 
-/* rtl-model/src/traverse_f8bvh_float.c.  Stats: nodes = inner records
+/* rtl-model/src/qbvh/traverse_f8bvh_float.c.  Stats: nodes = inner records
  * visited, box tests = their children (2..8) plus one for the root, 256
  * bytes (four lines) per node; 0, or -1 (stack overflow, a ray the units
  * reject). */

@@ -10,7 +10,7 @@
 #include "cbvh/bvh.h"
 #include "cbvh/traverse.h"
 
-/* ---- the stack unit (unit 8, rtl-model/src/qbvh_stack.c) --------------------
+/* ---- the stack unit (unit 8, rtl-model/src/units/qbvh_stack.c) --------------------
  * Entry: bits 25..0 first-child ID, bits 27..26 / 29..28 / 31..30 the offsets
  * o0, o1, o2 (0..3) of the siblings still to visit, near to far.  A missing
  * far sibling repeats the previous offset; an entry is exhausted when the
@@ -41,7 +41,7 @@ uint32_t cbvh_qstack_pop(uint32_t entry, uint32_t *node, uint32_t *next, int *ke
 uint64_t cbvh_qstack_push_wide(uint32_t first, const uint8_t order[4], int nhit);
 uint32_t cbvh_qstack_pop_wide(uint64_t entry, uint64_t *next, int *keep);
 
-/* ---- the QBVH (rtl-model/src/build_qbvh.c) --------------------------------
+/* ---- the QBVH (rtl-model/src/qbvh/build_qbvh.c) --------------------------------
  * Structure of arrays, node 0 = root (its own box in bmin/bmax[0]).  Node i:
  *   inner: children first[i] .. first[i]+count[i]-1 (2..4), contiguous
  *   leaf (count[i] & CBVH_QBVH_LEAF): primitives prims[first[i] ..
@@ -77,7 +77,7 @@ int cbvh_qbvh_check(const cbvh_qbvh *q, const cbvh_scene *s, char *err, size_t e
 /* Bytes of the node arrays (CBVH_QBVH_NODE_BYTES per node). */
 size_t cbvh_qbvh_node_bytes(const cbvh_qbvh *q);
 
-/* ---- traversal (rtl-model/src/traverse_qbvh.c) ---------------------------- */
+/* ---- traversal (rtl-model/src/qbvh/traverse_qbvh.c) ---------------------------- */
 typedef enum {
     CBVH_QSTACK_AUTO = 0,       /* compressed 32-bit if the tree fits 2^26, else wide */
     CBVH_QSTACK_COMPRESSED = 1, /* the paper's 32-bit entry (the unit); error past 2^26 */
@@ -98,7 +98,7 @@ int cbvh_qbvh_stack_check(const cbvh_qbvh *q, cbvh_qstack_kind kind, char *err, 
 int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits,
                     cbvh_trav_mode mode, cbvh_qstack_kind kind, cbvh_trav_hit *hit, cbvh_trav_stats *st);
 
-/* ---- plain floating-point traversal of the QBVH (rtl-model/src/traverse_qbvh_float.c)
+/* ---- plain floating-point traversal of the QBVH (rtl-model/src/qbvh/traverse_qbvh_float.c)
  * What a software renderer runs on the float BVH collapsed 4-wide
  * (docs/traversal.md §13): one 128-byte record per inner node with its
  * children's four boxes as [lower, upper][axis][child] binary32, tested by

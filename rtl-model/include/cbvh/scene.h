@@ -3,7 +3,7 @@
  * optional morph animation for refitting studies.
  *
  * Loading files and procedural scenes lives in the host tool
- * (host/scene_load.h); this header is what builders and traversal need. */
+ * (host/scene/scene_load.h); this header is what builders and traversal need. */
 #ifndef CBVH_SCENE_H
 #define CBVH_SCENE_H
 

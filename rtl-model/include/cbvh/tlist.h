@@ -1,13 +1,13 @@
 /* Stackless traversal lists over a bounding-sphere hierarchy (seed 004,
  * Toczek, Houzet, Mancini 2010).  Spec: docs/tlist.md.
  *
- *   rtl-model/src/build_bsh.c       the bounding-sphere hierarchy (octree-like
+ *   rtl-model/src/tlist/build_bsh.c       the bounding-sphere hierarchy (octree-like
  *                                   top-down split; big triangles stay at the node)
- *   rtl-model/src/build_tlists.c    flattening into 1, 2, 6 or 8 depth-first lists
+ *   rtl-model/src/tlist/build_tlists.c    flattening into 1, 2, 6 or 8 depth-first lists
  *                                   with relative escape indices
- *   rtl-model/src/tlist_heads.c     per-polygon and per-screen-cell list heads
- *   rtl-model/src/traverse_tlist.c  the stackless traversal loop
- *   rtl-model/src/ray_sphere.c      the ray-sphere unit (unit 9, in libcbvh) */
+ *   rtl-model/src/tlist/tlist_heads.c     per-polygon and per-screen-cell list heads
+ *   rtl-model/src/tlist/traverse_tlist.c  the stackless traversal loop
+ *   rtl-model/src/units/ray_sphere.c      the ray-sphere unit (unit 9, in libcbvh) */
 #ifndef CBVH_TLIST_H
 #define CBVH_TLIST_H
 
@@ -130,7 +130,7 @@ int cbvh_tlists_poly_heads(cbvh_tlists *L, const cbvh_tri *tris, cbvh_tlist_head
  * (within margin of the triangle) is the caller's. */
 uint32_t cbvh_tlist_poly_head(const cbvh_tlists *L, int l, uint32_t from, const cbvh_tri *tris, const cbvh_ray *ray);
 /* A margin for secondary rays whose origin is q = fl(fl(o + t d) + eps n)
- * (host/effects.c): eps plus the rounding error of the hit point, where
+ * (host/trace/effects.c): eps plus the rounding error of the hit point, where
  * coord_max bounds |coordinate| of every vertex, incoming-ray origin and hit
  * point.  docs/tlist.md §7.1. */
 float cbvh_tlist_hitpoint_margin(float eps, float coord_max);

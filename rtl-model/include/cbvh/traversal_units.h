@@ -61,14 +61,14 @@ typedef struct {
 uint32_t cbvh_ray_triangle(const cbvh_ray *ray, const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3],
                            cbvh_tri_result *out);
 
-/* Ray-sphere unit (unit 9, rtl-model/src/ray_sphere.c, docs/traversal.md §10):
+/* Ray-sphere unit (unit 9, rtl-model/src/units/ray_sphere.c, docs/traversal.md §10):
  * *hit = 1 iff the closed ball |p - c| <= r meets the segment o + t d,
  * t in [tmin, tmax] (tmax may be +Inf), decided exactly.  Status as the box
  * unit for the ray (NaN/Inf, zero direction); NaN/Inf c or r, or r < 0 (sign
  * bit set, -0 allowed) -> BAD_PARAM; *hit = 0 on any status. */
 uint32_t cbvh_ray_sphere(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r, int *hit);
 
-/* Facing of a triangle for direction d, exact (rtl-model/src/tri_facing.c):
+/* Facing of a triangle for direction d, exact (rtl-model/src/units/tri_facing.c):
  * +1 if d . ((v1 - v0) x (v2 - v0)) < 0 (the ray meets the counter-clockwise
  * front side), -1 if > 0 (back side), 0 if edge-on or degenerate.  Used by
  * one-sided traversal and by the traversal lists' back-face culling; not a

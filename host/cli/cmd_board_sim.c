@@ -1,0 +1,151 @@
+/* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cbvh_sim.h"
+#include "cli/commands.h"
+#include "util/parse_int.h"
+
+static volatile int stop_flag;
+static void on_signal(int sig) {
+    (void)sig;
+    stop_flag = 1;
+}
+
+#define RX_IDLE_MS_MAX 60000
+
+static void usage(FILE *f) {
+    fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--gateware PROG] [--faults SPEC] [--rx-idle-ms N]\n"
+               "                      [--break-unit UNIT] [--verbose]\n"
+               "  Runs the virtual board: the firmware core with the bit-exact model as its FPGA,\n"
+               "  or with --gateware the board's RTL simulated by Icarus Verilog (PROG from\n"
+               "  gateware/scripts/build-board-sim), driven over SPI as on the board;\n"
+               "  reachable with --backend sim:ADDR.  ADDR: unix:PATH (default unix:/tmp/cbvh-board-UID.sock)\n"
+               "  or tcp:HOST:PORT (PORT 1..65535); a stale unix socket left by a crashed board is replaced.\n"
+               "  --faults injects faults into the replies, e.g.\n"
+               "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1\n"
+               "  (rates in [0,1] adding up to at most 1, delay_ms 0..10000, seed a non-negative integer).\n"
+               "  --rx-idle-ms N: the firmware's inter-byte timeout, 1..60000 (default 20).\n"
+               "  --break-unit UNIT flips bit 0 of the unit's first output word (a test aid that\n"
+               "  plays a gateware bug: checks against this board must fail).\n"
+               "  Stops on SIGINT/SIGTERM and removes its socket file.\n"
+               "  Exit status: 0 stopped by SIGINT/SIGTERM while idle; 1 the board failed (ADDR cannot\n"
+               "  be listened on or another board listens there, the gateware simulation ended or hung,\n"
+               "  or a stop abandoned a gateware transaction in progress); 2 bad options or values.\n");
+}
+
+/* What each option's value is, for the one-line error when it is missing. */
+static const struct {
+    const char *name, *value;
+} valued_options[] = {
+    {"--listen", "unix:PATH or tcp:HOST:PORT"},
+    {"--gateware", "a program from gateware/scripts/build-board-sim"},
+    {"--faults", "a fault spec, e.g. drop=0.01,seed=1"},
+    {"--rx-idle-ms", "an integer in 1..60000"},
+    {"--break-unit", "a unit name, e.g. axis_compress"},
+};
+
+int cmd_board_sim(int argc, char **argv) {
+    char def[128];
+    snprintf(def, sizeof def, "unix:/tmp/cbvh-board-%u.sock", (unsigned)getuid());
+    const char *addr = def, *faults = NULL, *gateware = NULL;
+    int idle = 20, verbose = 0, broken = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            usage(stdout);
+            return 0;
+        }
+        if (strcmp(argv[i], "--verbose") == 0) {
+            verbose = 1;
+            continue;
+        }
+        const char *value_is = NULL;
+        for (size_t k = 0; k < sizeof valued_options / sizeof valued_options[0]; k++)
+            if (strcmp(argv[i], valued_options[k].name) == 0) value_is = valued_options[k].value;
+        if (!value_is) {
+            fprintf(stderr, "cbvh board-sim: unknown option '%s' (cbvh board-sim --help)\n", argv[i]);
+            return 2;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "cbvh board-sim: %s needs a value (%s)\n", argv[i], value_is);
+            return 2;
+        }
+        const char *opt = argv[i], *val = argv[++i];
+        if (strcmp(opt, "--listen") == 0) {
+            addr = val;
+        } else if (strcmp(opt, "--gateware") == 0) {
+            gateware = val;
+        } else if (strcmp(opt, "--faults") == 0) {
+            faults = val;
+        } else if (strcmp(opt, "--rx-idle-ms") == 0) {
+            long v;
+            if (cbvh_parse_long(val, 1, RX_IDLE_MS_MAX, &v)) {
+                fprintf(stderr, "cbvh board-sim: --rx-idle-ms expects an integer in 1..%d, got '%s'\n",
+                        RX_IDLE_MS_MAX, val);
+                return 2;
+            }
+            idle = (int)v;
+        } else { /* --break-unit */
+            const cbvh_unit *u = cbvh_unit_find(val);
+            if (!u) {
+                fprintf(stderr, "cbvh board-sim: --break-unit: unknown unit '%s'\n", val);
+                return 2;
+            }
+            broken = u->id;
+        }
+    }
+    char err[256];
+    cbvh_link_fault fl;
+    if (faults && cbvh_link_fault_parse(&fl, faults, err, sizeof err)) {
+        fprintf(stderr, "cbvh board-sim: --faults: %s\n", err);
+        return 2;
+    }
+    if (cbvh_sim_addr_check(addr, err, sizeof err)) {
+        fprintf(stderr, "cbvh board-sim: --listen: %s\n", err);
+        return 2;
+    }
+    cbvh_gateware *gw = NULL;
+    if (gateware && cbvh_gateware_check(gateware, err, sizeof err)) { /* bad input: exit 2, as a bad address */
+        fprintf(stderr, "cbvh board-sim: --gateware: %s\n", err);
+        return 2;
+    }
+    if (gateware && !(gw = cbvh_gateware_start(gateware, broken, err, sizeof err))) {
+        fprintf(stderr, "cbvh board-sim: --gateware: %s\n", err);
+        return 1;
+    }
+    int fd = cbvh_sim_listen(addr, err, sizeof err);
+    if (fd < 0) {
+        fprintf(stderr, "cbvh board-sim: %s%s\n", fd == CBVH_SIM_BAD_ADDR ? "--listen: " : "", err);
+        cbvh_gateware_stop(gw);
+        return fd == CBVH_SIM_BAD_ADDR ? 2 : 1; /* bad input, or the socket could not be opened */
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    printf("cbvh board-sim: listening on %s\n", addr);
+    fflush(stdout);
+    cbvh_sim_board_opts o = {fd, &stop_flag, idle, faults ? &fl : NULL, verbose, broken, gw};
+    int rc = cbvh_sim_board_serve(&o);
+    close(fd);
+    cbvh_sim_unlink(addr);
+    if (gw) {
+        if (cbvh_gateware_error(gw)) fprintf(stderr, "cbvh board-sim: %s\n", cbvh_gateware_error(gw));
+        else if (verbose)
+            fprintf(stderr, "cbvh board-sim: %llu SPI transactions\n",
+                    (unsigned long long)cbvh_gateware_transactions(gw));
+        cbvh_gateware_stop(gw);
+    }
+    if (faults) {
+        fprintf(stderr, "cbvh board-sim: reply frames %llu, faults injected:", (unsigned long long)fl.frames);
+        for (int k = 0; k < CBVH_FAULT_KINDS; k++)
+            fprintf(stderr, " %s %llu", cbvh_fault_names[k], (unsigned long long)fl.injected[k]);
+        fprintf(stderr, "\n");
+    }
+    return rc ? 1 : 0;
+}
