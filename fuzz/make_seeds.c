@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cbvh_fw/frame.h"
+#include "cbvh_fw/payload.h"
 static uint8_t buf[8192];
 static size_t frame(uint8_t *at, uint8_t cmd, uint8_t st, uint16_t seq, const uint8_t *p, uint16_t n) {
     if (n) memcpy(at + CBVH_FRAME_HDR, p, n); /* p may be NULL when n == 0 */

@@ -1,6 +1,7 @@
 /* Firmware core: parse frames, dispatch commands, stream batches through the
  * datapath.  Every malformed frame gets an error reply; the core never stops. */
 #include "cbvh_fw/fw.h"
+#include "cbvh_fw/payload.h"
 #include "cbvh_fw/regmap.h"
 
 void cbvh_fw_init(cbvh_fw *fw, const cbvh_fw_hal *hal) {
@@ -21,19 +22,20 @@ static void reply_error(cbvh_fw *fw, uint8_t cmd, uint8_t status, uint16_t seq) 
 
 static void do_identify(cbvh_fw *fw, uint16_t seq) {
     const cbvh_fw_hal *h = fw->hal;
-    uint8_t *p = fw->tx + CBVH_FRAME_HDR;
-    for (unsigned i = 0; i < CBVH_IDENTITY_BYTES; i++) p[i] = 0;
-    p[0] = CBVH_PROTO_VERSION;
-    p[1] = CBVH_FW_VERSION_MAJOR;
-    p[2] = CBVH_FW_VERSION_MINOR;
-    p[3] = CBVH_FW_VERSION_PATCH;
-    cbvh_put32(p + 4, h->reg_read(h->ctx, CBVH_REG_VERSION));
-    cbvh_put32(p + 8, h->reg_read(h->ctx, CBVH_REG_UNITS));
-    cbvh_put16(p + 12, CBVH_FRAME_MAX_PAYLOAD);
-    p[14] = CBVH_REG_WORDS;
-    cbvh_put32(p + 16, h->reg_read(h->ctx, CBVH_REG_ID));
+    cbvh_identity id = {0};
+    id.proto_version = CBVH_PROTO_VERSION;
+    id.fw_major = CBVH_FW_VERSION_MAJOR;
+    id.fw_minor = CBVH_FW_VERSION_MINOR;
+    id.fw_patch = CBVH_FW_VERSION_PATCH;
+    /* one statement each: the register reads go out in this order */
+    id.datapath_version = h->reg_read(h->ctx, CBVH_REG_VERSION);
+    id.units = h->reg_read(h->ctx, CBVH_REG_UNITS);
+    id.max_payload = CBVH_FRAME_MAX_PAYLOAD;
+    id.reg_words = CBVH_REG_WORDS;
+    id.reg_id = h->reg_read(h->ctx, CBVH_REG_ID);
     const char *name = h->board_name ? h->board_name : "";
-    for (unsigned i = 0; i < 15 && name[i]; i++) p[20 + i] = (uint8_t)name[i];
+    for (unsigned i = 0; i < sizeof id.board_name - 1 && name[i]; i++) id.board_name[i] = name[i];
+    cbvh_identity_put(fw->tx + CBVH_FRAME_HDR, &id);
     reply(fw, CBVH_CMD_IDENTIFY, CBVH_E_OK, seq, CBVH_IDENTITY_BYTES);
 }
 
@@ -48,26 +50,18 @@ static void do_status(cbvh_fw *fw, uint16_t seq) {
     reply(fw, CBVH_CMD_STATUS, CBVH_E_OK, seq, 4 * CBVH_FW_COUNTERS);
 }
 
-/* RUN request payload: u8 unit, i8 N, i16 min_scale, u8 encoding, u8 n_in,
- * u8 n_out, u8 0, u16 count, u16 0, then count*n_in words.
- * Reply payload: u16 count, u8 n_out, u8 unit, then count*n_out words. */
-#define RUN_HDR 12u
-#define RUN_REPLY_HDR 4u
+/* RUN: layouts in cbvh_fw/payload.h. */
 static void do_run(cbvh_fw *fw, const cbvh_frame *f) {
     const uint8_t *p = f->payload;
-    if (f->len < RUN_HDR || p[7] != 0 || cbvh_get16(p + 10) != 0) {
+    cbvh_run_hdr h;
+    if (cbvh_run_hdr_get(p, f->len, &h) || h.encoding > 1) {
         reply_error(fw, CBVH_CMD_RUN, CBVH_E_PAYLOAD, f->seq);
         return;
     }
-    uint8_t unit = p[0];
-    cbvh_fw_config cfg = {(int8_t)p[1], (int16_t)cbvh_get16(p + 2), p[4]};
-    unsigned n_in = p[5], n_out = p[6], count = cbvh_get16(p + 8);
-    if (cfg.encoding > 1) {
-        reply_error(fw, CBVH_CMD_RUN, CBVH_E_PAYLOAD, f->seq);
-        return;
-    }
+    cbvh_fw_config cfg = {h.quant_bits, h.min_scale, h.encoding};
+    unsigned n_in = h.n_in, n_out = h.n_out, count = h.count;
     uint32_t shape = 0;
-    int sel = cbvh_dp_select(fw->hal, unit, &cfg, &shape);
+    int sel = cbvh_dp_select(fw->hal, h.unit, &cfg, &shape);
     if (sel != CBVH_E_OK) {
         reply_error(fw, CBVH_CMD_RUN, (uint8_t)sel, f->seq);
         return;
@@ -78,20 +72,20 @@ static void do_run(cbvh_fw *fw, const cbvh_frame *f) {
         return;
     }
     unsigned long in_bytes = 4ul * n_in * count, out_bytes = 4ul * n_out * count;
-    if (RUN_REPLY_HDR + out_bytes > CBVH_FRAME_MAX_PAYLOAD) {
+    if (CBVH_RUN_REPLY_HDR + out_bytes > CBVH_FRAME_MAX_PAYLOAD) {
         reply_error(fw, CBVH_CMD_RUN, CBVH_E_TOO_BIG, f->seq);
         return;
     }
-    if (f->len != RUN_HDR + in_bytes) {
+    if (f->len != CBVH_RUN_HDR + in_bytes) {
         reply_error(fw, CBVH_CMD_RUN, CBVH_E_PAYLOAD, f->seq);
         return;
     }
     uint8_t *o = fw->tx + CBVH_FRAME_HDR;
-    cbvh_put16(o, (uint16_t)count);
-    o[2] = (uint8_t)n_out;
-    o[3] = unit;
+    cbvh_run_reply_hdr rh = {h.count, h.n_out, h.unit};
+    cbvh_run_reply_hdr_put(o, &rh);
     for (unsigned v = 0; v < count; v++) {
-        if (cbvh_dp_run_one(fw->hal, p + RUN_HDR + 4ul * n_in * v, n_in, o + RUN_REPLY_HDR + 4ul * n_out * v, n_out)) {
+        if (cbvh_dp_run_one(fw->hal, p + CBVH_RUN_HDR + 4ul * n_in * v, n_in, o + CBVH_RUN_REPLY_HDR + 4ul * n_out * v,
+                            n_out)) {
             fw->n.datapath_errors++;
             fw->hal->reg_write(fw->hal->ctx, CBVH_REG_CTRL, CBVH_CTRL_RESET);
             reply_error(fw, CBVH_CMD_RUN, CBVH_E_DATAPATH, f->seq);
@@ -100,7 +94,7 @@ static void do_run(cbvh_fw *fw, const cbvh_frame *f) {
         fw->n.vectors++;
     }
     fw->n.batches++;
-    reply(fw, CBVH_CMD_RUN, CBVH_E_OK, f->seq, (uint16_t)(RUN_REPLY_HDR + out_bytes));
+    reply(fw, CBVH_CMD_RUN, CBVH_E_OK, f->seq, (uint16_t)(CBVH_RUN_REPLY_HDR + out_bytes));
 }
 
 static void dispatch(cbvh_fw *fw, const cbvh_frame *f) {

@@ -7,9 +7,6 @@
 #include <string.h>
 #include <time.h>
 
-#define RUN_HDR 12u
-#define RUN_REPLY_HDR 4u
-
 /* What a request-class error code means, for the one-line message
  * (docs/protocol.md, "Error replies"). */
 static const char *request_error_meaning(unsigned code) {
@@ -242,22 +239,9 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
 }
 
 int cbvh_identity_parse(const uint8_t *p, size_t len, cbvh_identity *id) {
-    if (len != CBVH_IDENTITY_BYTES) return -1;
-    memset(id, 0, sizeof *id);
-    id->proto_version = p[0];
-    id->fw_major = p[1];
-    id->fw_minor = p[2];
-    id->fw_patch = p[3];
-    id->datapath_version = cbvh_get32(p + 4);
-    id->units = cbvh_get32(p + 8);
-    id->max_payload = cbvh_get16(p + 12);
-    id->reg_words = p[14];
-    id->reg_id = cbvh_get32(p + 16);
-    for (int i = 0; i < 15; i++) {
-        char c = (char)p[20 + i];
-        if (c == 0) break;
-        id->board_name[i] = (c >= 32 && c < 127) ? c : '?';
-    }
+    if (cbvh_identity_get(p, len, id)) return -1;
+    for (char *c = id->board_name; *c; c++)
+        if (*c < 32 || *c >= 127) *c = '?';
     if (id->proto_version != CBVH_PROTO_VERSION || id->max_payload < 64 || id->max_payload > CBVH_FRAME_MAX_PAYLOAD)
         return -1;
     return 0;
@@ -273,19 +257,15 @@ int cbvh_link_identify(cbvh_link *l, char *err, size_t errlen) {
     return 0;
 }
 
-/* Vectors per RUN frame when neither request nor reply may exceed max_payload. */
-static size_t batch_limit(size_t max_payload, int n_in, int n_out) {
-    size_t a = (max_payload - RUN_HDR) / (4u * (size_t)n_in);
-    size_t b = (max_payload - RUN_REPLY_HDR) / (4u * (size_t)n_out);
-    return a < b ? a : b;
+size_t cbvh_link_max_batch(int n_in, int n_out) {
+    return cbvh_run_max_batch(CBVH_FRAME_MAX_PAYLOAD, (unsigned)n_in, (unsigned)n_out);
 }
 
-size_t cbvh_link_max_batch(int n_in, int n_out) { return batch_limit(CBVH_FRAME_MAX_PAYLOAD, n_in, n_out); }
-
 int cbvh_run_reply_check(const uint8_t *p, size_t len, uint8_t unit, unsigned count, unsigned n_out) {
-    if (len < RUN_REPLY_HDR) return -1;
-    if (cbvh_get16(p) != count || p[2] != n_out || p[3] != unit) return -1;
-    return len == RUN_REPLY_HDR + 4ul * n_out * count ? 0 : -1;
+    cbvh_run_reply_hdr h;
+    if (cbvh_run_reply_hdr_get(p, len, &h)) return -1;
+    if (h.count != count || h.n_out != n_out || h.unit != unit) return -1;
+    return len == CBVH_RUN_REPLY_HDR + 4ul * n_out * count ? 0 : -1;
 }
 
 int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out,
@@ -306,7 +286,7 @@ int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *c
     /* The board may take smaller frames than the protocol allows (IDENTIFY's
      * max payload, at least 64): batches are cut to what it said. */
     size_t cap = l->ident.max_payload ? l->ident.max_payload : CBVH_FRAME_MAX_PAYLOAD;
-    size_t max = batch_limit(cap, lay.n_in, lay.n_out);
+    size_t max = cbvh_run_max_batch(cap, (unsigned)lay.n_in, (unsigned)lay.n_out);
     if (max == 0) {
         snprintf(err, errlen, "unit %s (%d->%d words) does not fit the board's %zu-byte frames", unit->name,
                  lay.n_in, lay.n_out, cap);
@@ -315,20 +295,19 @@ int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *c
     uint8_t *payload = l->req;
     for (size_t done = 0; done < count;) {
         size_t k = count - done < max ? count - done : max;
-        payload[0] = unit->id;
-        payload[1] = (uint8_t)(int8_t)cfg->params.quant_bits;
-        cbvh_put16(payload + 2, (uint16_t)(int16_t)cfg->params.min_scale);
-        payload[4] = (uint8_t)cfg->enc;
-        payload[5] = (uint8_t)lay.n_in;
-        payload[6] = (uint8_t)lay.n_out;
-        payload[7] = 0;
-        cbvh_put16(payload + 8, (uint16_t)k);
-        cbvh_put16(payload + 10, 0);
+        cbvh_run_hdr h = {.unit = unit->id,
+                          .quant_bits = (int8_t)cfg->params.quant_bits,
+                          .min_scale = (int16_t)cfg->params.min_scale,
+                          .encoding = (uint8_t)cfg->enc,
+                          .n_in = (uint8_t)lay.n_in,
+                          .n_out = (uint8_t)lay.n_out,
+                          .count = (uint16_t)k};
+        cbvh_run_hdr_put(payload, &h);
         const uint32_t *src = in + done * (size_t)lay.n_in;
-        for (size_t i = 0; i < k * (size_t)lay.n_in; i++) cbvh_put32(payload + RUN_HDR + 4 * i, src[i]);
+        for (size_t i = 0; i < k * (size_t)lay.n_in; i++) cbvh_put32(payload + CBVH_RUN_HDR + 4 * i, src[i]);
         uint16_t rlen = 0;
         char why[400];
-        if (cbvh_link_transact(l, CBVH_CMD_RUN, payload, (uint16_t)(RUN_HDR + 4 * k * (size_t)lay.n_in), &rlen, why,
+        if (cbvh_link_transact(l, CBVH_CMD_RUN, payload, (uint16_t)(CBVH_RUN_HDR + 4 * k * (size_t)lay.n_in), &rlen, why,
                                sizeof why)) {
             snprintf(err, errlen, "%s: vectors %zu..%zu not run: %s", unit->name, done, done + k - 1, why);
             return -1;
@@ -340,7 +319,7 @@ int cbvh_link_run(cbvh_link *l, const cbvh_unit *unit, const cbvh_unit_config *c
             return -1;
         }
         uint32_t *dst = out + done * (size_t)lay.n_out;
-        for (size_t i = 0; i < k * (size_t)lay.n_out; i++) dst[i] = cbvh_get32(l->reply + RUN_REPLY_HDR + 4 * i);
+        for (size_t i = 0; i < k * (size_t)lay.n_out; i++) dst[i] = cbvh_get32(l->reply + CBVH_RUN_REPLY_HDR + 4 * i);
         done += k;
     }
     return 0;

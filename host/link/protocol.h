@@ -9,6 +9,7 @@
 
 #include "cbvh/unit_table.h"
 #include "cbvh_fw/frame.h"
+#include "cbvh_fw/payload.h"
 
 /* One transport's byte I/O. */
 typedef struct {
@@ -30,15 +31,6 @@ typedef struct {
     uint64_t link_breaks, reopens, retries, failures;
     uint64_t bad_replies; /* CRC fine but fields inconsistent */
 } cbvh_link_stats;
-
-typedef struct {
-    uint8_t proto_version, fw_major, fw_minor, fw_patch;
-    uint32_t datapath_version, units;
-    uint16_t max_payload;
-    uint8_t reg_words;
-    uint32_t reg_id;
-    char board_name[16];
-} cbvh_identity;
 
 typedef struct {
     cbvh_link_io io;

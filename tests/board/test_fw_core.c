@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "cbvh_fw/fw.h"
+#include "cbvh_fw/payload.h"
 #include "cbvh_fw/regmap.h"
 #include "cbvh_sim.h"
 

@@ -25,9 +25,9 @@
 #define CBVH_REPLY 0x80u
 
 enum {
-    CBVH_CMD_IDENTIFY = 0x01, /* -> cbvh_identity payload */
+    CBVH_CMD_IDENTIFY = 0x01, /* -> cbvh_identity payload (payload.h) */
     CBVH_CMD_RESET = 0x02,    /* reset datapath and counters */
-    CBVH_CMD_RUN = 0x03,      /* run a batch of vectors on one unit */
+    CBVH_CMD_RUN = 0x03,      /* run a batch of vectors on one unit (payload.h) */
     CBVH_CMD_LOOPBACK = 0x04, /* echo the payload */
     CBVH_CMD_STATUS = 0x05,   /* counters */
 };
@@ -50,8 +50,6 @@ enum {
     CBVH_E_DATAPATH = 12,  /* datapath did not finish / flagged an error */
     CBVH_E_CONFIG = 13,    /* unit present but not built for this N / min_scale / encoding */
 };
-
-#define CBVH_IDENTITY_BYTES 40 /* IDENTIFY reply payload; layout in fw.h */
 
 static inline int cbvh_error_is_link(unsigned code) { return code >= CBVH_E_CRC && code <= CBVH_E_TIMEOUT; }
 const char *cbvh_error_name(unsigned code);

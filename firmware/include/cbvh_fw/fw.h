@@ -37,13 +37,6 @@ typedef struct {
     cbvh_fw_counters n;
 } cbvh_fw;
 
-/* IDENTIFY reply payload (little-endian, CBVH_IDENTITY_BYTES bytes, frame.h). */
-/*  0 u8  protocol version      1 u8 fw major   2 u8 fw minor   3 u8 fw patch
- *  4 u32 datapath version      8 u32 unit bitmask
- * 12 u16 max payload          14 u8 register window words      15 u8 reserved
- * 16 u32 REG_ID               20 char[16] board name (NUL padded)
- * 36 u32 reserved */
-
 void cbvh_fw_init(cbvh_fw *fw, const cbvh_fw_hal *hal);
 /* Feeds bytes received from the host; replies go out through hal->send. */
 void cbvh_fw_rx(cbvh_fw *fw, const uint8_t *data, size_t n);
