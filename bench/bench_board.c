@@ -16,8 +16,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "link/board_link.h"
 #include "cbvh_sim.h"
+#include "link/board_link.h"
+#include "link/sim_addr.h"
 #include "gen_inputs.h"
 
 static double now_s(void) {

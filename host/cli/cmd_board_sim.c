@@ -7,6 +7,8 @@
 
 #include "cbvh_sim.h"
 #include "cli/commands.h"
+#include "link/link_fault.h"
+#include "link/sim_addr.h"
 #include "util/parse_int.h"
 
 static volatile int stop_flag;

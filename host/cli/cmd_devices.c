@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "link/board_link.h"
-#include "cbvh_sim.h"
+#include "link/sim_addr.h"
 #include "cli/commands.h"
 
 int cmd_devices(int argc, char **argv) {

@@ -1,6 +1,6 @@
 #include "link/backend.h"
-#include "cbvh_sim.h"
 #include "link/protocol.h"
+#include "link/sim_addr.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -5,7 +5,7 @@
 #define CBVH_HOST_BOARD_LINK_H
 
 #include "link/backend.h"
-#include "link_fault.h"
+#include "link/link_fault.h"
 #include "link/protocol.h"
 
 /* The link of an open usb/hid/sim backend, or NULL for the model. */

@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include "link/board_link.h"
-#include "cbvh_sim.h"
+#include "link/sim_addr.h"
 
 typedef struct {
     cbvh_link link; /* first: see board_link.h */

@@ -17,7 +17,6 @@
 
 #include "link/backend.h"
 #include "link/board_link.h"
-#include "cbvh_sim.h"
 #include "gen_inputs.h"
 
 static pid_t board = -1;

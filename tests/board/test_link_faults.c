@@ -12,8 +12,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "link/board_link.h"
 #include "cbvh_sim.h"
+#include "link/board_link.h"
+#include "link/sim_addr.h"
 #include "gen_inputs.h"
 
 static char dir[256], sock_path[300], addr[320], spec[330];

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "link/board_link.h"
-#include "cbvh_sim.h"
+#include "link/sim_addr.h"
 #include "test_util.h"
 
 static int fails;

@@ -1,5 +1,8 @@
 /* The sim port: the firmware core on the host.  The USB endpoints are a
- * socket; the FPGA register map is backed by the bit-exact model (libcbvh). */
+ * socket; the FPGA register map is backed by the bit-exact model (libcbvh).
+ * The board's addresses and the fault injector on its replies are the host's
+ * link library (host/link/sim_addr.h, host/link/link_fault.h), which the
+ * host's sim backend uses too. */
 #ifndef CBVH_FW_SIM_H
 #define CBVH_FW_SIM_H
 
@@ -9,7 +12,10 @@
 #include "cbvh/unit_table.h"
 #include "cbvh_fw/fw.h"
 #include "cbvh_fw/regmap.h"
-#include "link_fault.h"
+
+/* host/link/link_fault.h, not included: this header cross-compiles without
+ * the host's headers (the qemu self-test uses the register-map model). */
+typedef struct cbvh_link_fault cbvh_link_fault;
 
 /* Model-backed register map (regmap_model.c). */
 typedef struct {
@@ -45,23 +51,8 @@ uint64_t cbvh_gateware_transactions(const cbvh_gateware *g);
 void cbvh_gateware_watch_stop(cbvh_gateware *g, volatile int *stop);
 void cbvh_gateware_stop(cbvh_gateware *g);
 
-/* Board addresses: "unix:PATH", "tcp:HOST:PORT" (PORT 1..65535), or a bare
- * PATH (contains '/').  Returns a connected/listening fd, or with err set
- * CBVH_SIM_BAD_ADDR when the address itself is wrong (syntax, port range, no
- * such host) and -1 on any other failure.  Listening on a unix PATH that is
- * a socket nobody accepts on (left by a crashed board) replaces it; one a
- * board is listening on fails with "another board is already listening on
- * PATH". */
-#define CBVH_SIM_BAD_ADDR (-2)
-int cbvh_sim_listen(const char *addr, char *err, size_t errlen);
-int cbvh_sim_connect(const char *addr, char *err, size_t errlen);
-/* Checks an address's syntax and port range only: 0, or -1 with err set. */
-int cbvh_sim_addr_check(const char *addr, char *err, size_t errlen);
-/* Removes a unix socket file created by cbvh_sim_listen. */
-void cbvh_sim_unlink(const char *addr);
-
 typedef struct {
-    int listen_fd;
+    int listen_fd;            /* from cbvh_sim_listen (host/link/sim_addr.h) */
     volatile int *stop;       /* serve returns soon after *stop becomes non-zero */
     int rx_idle_ms;           /* inter-byte timeout of the firmware parser */
     cbvh_link_fault *faults;  /* faults on the reply direction, or NULL */

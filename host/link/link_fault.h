@@ -1,8 +1,10 @@
 /* Fault injection on a socket link: each outgoing frame may be dropped,
  * corrupted, duplicated, truncated, delayed, or the connection cut.  Used on
- * both ends of the sim link (host requests, board replies). */
-#ifndef CBVH_LINK_FAULT_H
-#define CBVH_LINK_FAULT_H
+ * both ends of the sim link: the host's requests (transport_socket.c) and the
+ * virtual board's replies (firmware/ports/sim).  Library cbvh_link_socket,
+ * with sim_addr.h. */
+#ifndef CBVH_HOST_LINK_FAULT_H
+#define CBVH_HOST_LINK_FAULT_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -10,7 +12,7 @@
 enum { CBVH_FAULT_DROP, CBVH_FAULT_CORRUPT, CBVH_FAULT_DUP, CBVH_FAULT_TRUNC, CBVH_FAULT_DELAY, CBVH_FAULT_DISCONNECT,
        CBVH_FAULT_KINDS };
 
-typedef struct {
+typedef struct cbvh_link_fault {
     double rate[CBVH_FAULT_KINDS]; /* probability per frame of each fault */
     int delay_ms;                  /* how long DELAY holds a frame */
     uint64_t rng;

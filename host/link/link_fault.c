@@ -1,6 +1,6 @@
 /* Fault injector for the socket link (see link_fault.h). */
 #define _GNU_SOURCE
-#include "link_fault.h"
+#include "link/link_fault.h"
 
 #include <ctype.h>
 #include <errno.h>
