@@ -3,7 +3,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "link/board_link.h"
+#include "link/backend.h"
+#include "link/protocol.h"
 #include "link/sim_addr.h"
 #include "cli/commands.h"
 
@@ -38,24 +39,8 @@ int cmd_devices(int argc, char **argv) {
         fprintf(stderr, "cbvh devices: %s: %s\n", sim_from, err);
         return 2;
     }
-    int boards = cbvh_usb_describe(stdout);
-    boards += cbvh_hid_describe(stdout);
-    if (sim && *sim) {
-        cbvh_backend b;
-        char spec[300];
-        snprintf(spec, sizeof spec, "sim:%s", sim);
-        if (cbvh_backend_open(spec, &b, NULL, err, sizeof err) == 0) {
-            cbvh_link *l = cbvh_backend_link(&b);
-            printf("sim:   %s, units 0x%08x, max payload %u\n", b.label, l ? (unsigned)l->ident.units : 0u,
-                   l ? l->ident.max_payload : 0u);
-            cbvh_backend_close(&b);
-            boards++;
-        } else {
-            printf("sim:   none (%s)\n", err);
-        }
-    } else {
-        printf("sim:   not probed (give --sim ADDR or CBVH_SIM_ADDR; start one with `cbvh board-sim`)\n");
-    }
-    printf("model: libcbvh datapath v%d (always available; --backend auto falls back to it)\n", CBVH_DATAPATH_VERSION);
+    /* Every backend in the table, in its order; --sim is the sim backend's argument. */
+    for (const cbvh_backend_ops *const *o = cbvh_backends; *o; o++)
+        (*o)->list(*o == &cbvh_backend_sim && sim && *sim ? sim : NULL, stdout);
     return 0;
 }

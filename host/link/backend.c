@@ -2,6 +2,7 @@
 #include "link/protocol.h"
 #include "link/sim_addr.h"
 
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,6 +31,20 @@ int cbvh_usb_identity(uint16_t *vid, uint16_t *pid, char *err, size_t errlen) {
         return -1;
     }
     return 0;
+}
+
+const cbvh_backend_ops *const cbvh_backends[] = {&cbvh_backend_usb, &cbvh_backend_hid, &cbvh_backend_sim,
+                                                &cbvh_backend_model, NULL};
+
+void cbvh_backend_list_line(FILE *out, const cbvh_backend_ops *ops, const char *fmt, ...) {
+    char name[16];
+    snprintf(name, sizeof name, "%s:", ops->name);
+    fprintf(out, "%-7s", name);
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(out, fmt, ap);
+    va_end(ap);
+    fputc('\n', out);
 }
 
 static int open_one(const cbvh_backend_ops *ops, const char *arg, cbvh_backend *b, char *err, size_t errlen) {
@@ -77,12 +92,10 @@ static int open_auto(cbvh_backend *b, FILE *log, char *err, size_t errlen) {
 /* The backend a spec names ("name" or "name:arg"); *arg gets the text after
  * the colon, or NULL.  NULL with err set for an unknown name. */
 static const cbvh_backend_ops *find_backend(const char *spec, const char **arg, char *err, size_t errlen) {
-    static const cbvh_backend_ops *const all[] = {&cbvh_backend_model, &cbvh_backend_usb, &cbvh_backend_hid,
-                                                  &cbvh_backend_sim};
     size_t n = strcspn(spec, ":");
     *arg = spec[n] == ':' ? spec + n + 1 : NULL;
-    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
-        if (strlen(all[i]->name) == n && strncmp(all[i]->name, spec, n) == 0) return all[i];
+    for (const cbvh_backend_ops *const *o = cbvh_backends; *o; o++)
+        if (strlen((*o)->name) == n && strncmp((*o)->name, spec, n) == 0) return *o;
     snprintf(err, errlen, "unknown backend '%s' (expected auto, model, usb, hid or sim:ADDR)", spec);
     return NULL;
 }

@@ -1,5 +1,6 @@
 /* One backend interface for every way of running a unit (OpenOCD CMSIS-DAP
- * style): a table of functions per backend, one backend per file.
+ * style): a table of functions per backend, one backend per file, and one
+ * table of the backends (cbvh_backends) that `cbvh devices` lists.
  *   backend_model.c   in-process bit-exact model
  *   transport_usb.c   libusb bulk (board)
  *   transport_hid.c   hidapi HID (board)
@@ -36,6 +37,11 @@ typedef struct {
      * count*n_out words.  0 on success, CBVH_BACKEND_ERROR otherwise. */
     int (*run)(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_config *cfg, const uint32_t *in,
                uint32_t *out, size_t count, char *err, size_t errlen);
+    /* `cbvh devices`: writes one line (cbvh_backend_list_line) per device
+     * the backend finds, or one saying why it finds none, and returns how
+     * many it found.  arg as for open: the text after "name:" (the sim
+     * backend's address), NULL when not given. */
+    int (*list)(const char *arg, FILE *out);
 } cbvh_backend_ops;
 
 enum { CBVH_BACKEND_OK = 0, CBVH_BACKEND_NONE = 1, CBVH_BACKEND_ERROR = 2, CBVH_BACKEND_BAD_INPUT = 3 };
@@ -50,6 +56,16 @@ extern const cbvh_backend_ops cbvh_backend_model;
 extern const cbvh_backend_ops cbvh_backend_usb;
 extern const cbvh_backend_ops cbvh_backend_hid;
 extern const cbvh_backend_ops cbvh_backend_sim; /* transport_socket.c: "sim:ADDR", the virtual board */
+
+/* Every backend, in the order `--backend auto` probes them and `cbvh devices`
+ * lists them: usb, hid, sim, model; NULL-terminated. */
+extern const cbvh_backend_ops *const cbvh_backends[];
+
+/* One line of a device listing: "name:" in a 7-column field, then the text. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+void cbvh_backend_list_line(FILE *out, const cbvh_backend_ops *ops, const char *fmt, ...);
 
 /* Is spec well formed (a known name, an argument its backend takes)?  Opens
  * nothing, so a command can reject it before it prints anything.  0, or -1

@@ -29,4 +29,12 @@ static int model_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_con
     return CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_model = {"model", model_check_arg, model_open, model_close, model_run};
+static int model_list(const char *arg, FILE *out) {
+    (void)arg;
+    cbvh_backend_list_line(out, &cbvh_backend_model,
+                           "libcbvh datapath v%d (always available; --backend auto falls back to it)",
+                           CBVH_DATAPATH_VERSION);
+    return 1;
+}
+
+const cbvh_backend_ops cbvh_backend_model = {"model", model_check_arg, model_open, model_close, model_run, model_list};

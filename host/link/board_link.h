@@ -19,8 +19,8 @@ void cbvh_sim_set_faults(cbvh_backend *b, cbvh_link_fault *f);
 /* Human-readable one-line summary of link statistics. */
 void cbvh_link_stats_line(const cbvh_link_stats *s, char *buf, size_t n);
 
-/* `cbvh devices`: one line per board found (or one saying why none). */
-int cbvh_usb_describe(FILE *out);
-int cbvh_hid_describe(FILE *out);
+/* What the usb and hid backends say when the board's device node cannot be
+ * opened or seen (no permission). */
+#define CBVH_UDEV_HINT "install firmware/udev/60-cbvh.rules into /etc/udev/rules.d and replug"
 
 #endif

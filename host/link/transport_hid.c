@@ -21,8 +21,6 @@ typedef struct {
     uint16_t vid, pid; /* from the environment, checked once at open */
 } hid_state;
 
-static const char *udev_hint = "install firmware/udev/60-cbvh.rules into /etc/udev/rules.d and replug";
-
 static int hid_attach(hid_state *s, char *err, size_t errlen, int *none) {
     uint16_t vid = s->vid, pid = s->pid;
     struct hid_device_info *devs = hid_enumerate(vid, pid);
@@ -35,7 +33,7 @@ static int hid_attach(hid_state *s, char *err, size_t errlen, int *none) {
     s->dev = hid_open(vid, pid, s->use_serial ? s->serial : NULL);
     if (!s->dev) {
         snprintf(err, errlen, "HID device %04x:%04x found but cannot be opened (%ls); %s", vid, pid,
-                 hid_error(NULL) ? hid_error(NULL) : L"no reason given", udev_hint);
+                 hid_error(NULL) ? hid_error(NULL) : L"no reason given", CBVH_UDEV_HINT);
         return -1;
     }
     return 0;
@@ -145,30 +143,34 @@ static int hid_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_confi
     return cbvh_link_run(&s->link, unit, cfg, in, out, count, err, errlen) ? CBVH_BACKEND_ERROR : CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_hid = {"hid", NULL, hid_open_board, hid_close_board, hid_run};
-
-int cbvh_hid_describe(FILE *out) {
+static int hid_list(const char *arg, FILE *out) {
+    (void)arg; /* every board is listed, whatever its serial */
     uint16_t vid, pid;
     char why[200];
     if (cbvh_usb_identity(&vid, &pid, why, sizeof why)) {
-        fprintf(out, "hid:   not probed (%s)\n", why);
+        cbvh_backend_list_line(out, &cbvh_backend_hid, "not probed (%s)", why);
         return 0;
     }
     if (hid_init() != 0) {
-        fprintf(out, "hid:   none (hid_init failed)\n");
+        cbvh_backend_list_line(out, &cbvh_backend_hid, "none (hid_init failed)");
         return 0;
     }
     struct hid_device_info *devs = hid_enumerate(vid, pid);
     int found = 0;
     for (struct hid_device_info *d = devs; d; d = d->next) {
         found++;
-        fprintf(out, "hid:   %04x:%04x %s \"%ls\" serial %ls\n", d->vendor_id, d->product_id, d->path,
-                d->product_string ? d->product_string : L"?", d->serial_number ? d->serial_number : L"?");
+        cbvh_backend_list_line(out, &cbvh_backend_hid, "%04x:%04x %s \"%ls\" serial %ls", d->vendor_id, d->product_id,
+                               d->path, d->product_string ? d->product_string : L"?",
+                               d->serial_number ? d->serial_number : L"?");
     }
     hid_free_enumeration(devs);
     if (!found)
-        fprintf(out, "hid:   none (no HID device %04x:%04x; without permission on /dev/hidraw* or /dev/bus/usb "
-                     "boards are invisible: %s)\n", vid, pid, udev_hint);
+        cbvh_backend_list_line(out, &cbvh_backend_hid,
+                               "none (no HID device %04x:%04x; without permission on /dev/hidraw* or /dev/bus/usb "
+                               "boards are invisible: %s)",
+                               vid, pid, CBVH_UDEV_HINT);
     hid_exit();
     return found;
 }
+
+const cbvh_backend_ops cbvh_backend_hid = {"hid", NULL, hid_open_board, hid_close_board, hid_run, hid_list};

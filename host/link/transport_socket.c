@@ -131,7 +131,29 @@ static int sim_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_confi
     return cbvh_link_run(&s->link, unit, cfg, in, out, count, err, errlen) ? CBVH_BACKEND_ERROR : CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_sim = {"sim", sim_check_arg, sim_open, sim_close, sim_run};
+/* The board at arg, as `--backend sim:ARG` would open it. */
+static int sim_list(const char *arg, FILE *out) {
+    if (!arg || !*arg) {
+        cbvh_backend_list_line(out, &cbvh_backend_sim,
+                               "not probed (give --sim ADDR or CBVH_SIM_ADDR; start one with `cbvh board-sim`)");
+        return 0;
+    }
+    cbvh_backend b;
+    memset(&b, 0, sizeof b);
+    b.ops = &cbvh_backend_sim;
+    char err[300];
+    if (sim_open(&b, arg, err, sizeof err) != CBVH_BACKEND_OK) {
+        cbvh_backend_list_line(out, &cbvh_backend_sim, "none (%s)", err);
+        return 0;
+    }
+    const cbvh_identity *id = &((sim_state *)b.state)->link.ident;
+    cbvh_backend_list_line(out, &cbvh_backend_sim, "%s, units 0x%08x, max payload %u", b.label, (unsigned)id->units,
+                           id->max_payload);
+    sim_close(&b);
+    return 1;
+}
+
+const cbvh_backend_ops cbvh_backend_sim = {"sim", sim_check_arg, sim_open, sim_close, sim_run, sim_list};
 
 void cbvh_sim_set_faults(cbvh_backend *b, cbvh_link_fault *f) {
     if (b->ops == &cbvh_backend_sim && b->state) ((sim_state *)b->state)->faults = f;

@@ -19,26 +19,23 @@ typedef struct {
     char serial[64];
 } usb_state;
 
-static const char *udev_hint = "install firmware/udev/60-cbvh.rules into /etc/udev/rules.d and replug";
-
 /* Finds the board (optionally by serial) and opens and claims it. */
 static int usb_attach(usb_state *s, char *err, size_t errlen, int *none) {
     uint16_t vid = s->vid, pid = s->pid;
     libusb_device **list = NULL;
     ssize_t n = libusb_get_device_list(s->ctx, &list);
-    int rc = -1, seen = 0;
+    int rc = -1;
     *none = 1;
     snprintf(err, errlen, "no device %04x:%04x on the USB bus (%ld devices seen)", vid, pid, (long)(n < 0 ? 0 : n));
     for (ssize_t i = 0; i < n && rc != 0; i++) {
         struct libusb_device_descriptor d;
         if (libusb_get_device_descriptor(list[i], &d) != 0 || d.idVendor != vid || d.idProduct != pid) continue;
-        seen++;
         *none = 0;
         libusb_device_handle *h = NULL;
         int o = libusb_open(list[i], &h);
         if (o != 0) {
             snprintf(err, errlen, "device %04x:%04x found but cannot be opened: %s%s%s", vid, pid, libusb_strerror(o),
-                     o == LIBUSB_ERROR_ACCESS ? "; " : "", o == LIBUSB_ERROR_ACCESS ? udev_hint : "");
+                     o == LIBUSB_ERROR_ACCESS ? "; " : "", o == LIBUSB_ERROR_ACCESS ? CBVH_UDEV_HINT : "");
             continue;
         }
         if (s->serial[0]) {
@@ -81,7 +78,6 @@ static int usb_attach(usb_state *s, char *err, size_t errlen, int *none) {
         s->ep_out = out;
         rc = 0;
     }
-    (void)seen;
     if (list) libusb_free_device_list(list, 1);
     return rc;
 }
@@ -184,19 +180,18 @@ static int usb_run(cbvh_backend *b, const cbvh_unit *unit, const cbvh_unit_confi
     return cbvh_link_run(&s->link, unit, cfg, in, out, count, err, errlen) ? CBVH_BACKEND_ERROR : CBVH_BACKEND_OK;
 }
 
-const cbvh_backend_ops cbvh_backend_usb = {"usb", NULL, usb_open, usb_close, usb_run};
-
-int cbvh_usb_describe(FILE *out) {
+static int usb_list(const char *arg, FILE *out) {
+    (void)arg; /* every board is listed, whatever its serial */
     uint16_t vid, pid;
     char why[200];
     if (cbvh_usb_identity(&vid, &pid, why, sizeof why)) {
-        fprintf(out, "usb:   not probed (%s)\n", why);
+        cbvh_backend_list_line(out, &cbvh_backend_usb, "not probed (%s)", why);
         return 0;
     }
     libusb_context *ctx = NULL;
     int rc = libusb_init(&ctx);
     if (rc != 0) {
-        fprintf(out, "usb:   none (libusb_init failed: %s; no USB bus?)\n", libusb_strerror(rc));
+        cbvh_backend_list_line(out, &cbvh_backend_usb, "none (libusb_init failed: %s; no USB bus?)", libusb_strerror(rc));
         return 0;
     }
     libusb_device **list = NULL;
@@ -213,18 +208,21 @@ int cbvh_usb_describe(FILE *out) {
             if (d.iProduct) libusb_get_string_descriptor_ascii(h, d.iProduct, prod, sizeof prod);
             if (d.iSerialNumber) libusb_get_string_descriptor_ascii(h, d.iSerialNumber, sn, sizeof sn);
             libusb_close(h);
-            fprintf(out, "usb:   %04x:%04x bus %u addr %u \"%s\" serial %s\n", vid, pid, libusb_get_bus_number(list[i]),
-                    libusb_get_device_address(list[i]), prod, sn);
+            cbvh_backend_list_line(out, &cbvh_backend_usb, "%04x:%04x bus %u addr %u \"%s\" serial %s", vid, pid,
+                                   libusb_get_bus_number(list[i]), libusb_get_device_address(list[i]), prod, sn);
         } else {
-            fprintf(out, "usb:   %04x:%04x bus %u addr %u: cannot open (%s)%s%s\n", vid, pid,
-                    libusb_get_bus_number(list[i]), libusb_get_device_address(list[i]), libusb_strerror(o),
-                    o == LIBUSB_ERROR_ACCESS ? "; " : "", o == LIBUSB_ERROR_ACCESS ? udev_hint : "");
+            cbvh_backend_list_line(out, &cbvh_backend_usb, "%04x:%04x bus %u addr %u: cannot open (%s)%s%s", vid, pid,
+                                   libusb_get_bus_number(list[i]), libusb_get_device_address(list[i]),
+                                   libusb_strerror(o), o == LIBUSB_ERROR_ACCESS ? "; " : "",
+                                   o == LIBUSB_ERROR_ACCESS ? CBVH_UDEV_HINT : "");
         }
     }
     if (!found)
-        fprintf(out, "usb:   none (%ld USB devices visible, none is %04x:%04x%s)\n", (long)(n < 0 ? 0 : n), vid, pid,
-                n <= 0 ? "; no USB bus or no access to /dev/bus/usb" : "");
+        cbvh_backend_list_line(out, &cbvh_backend_usb, "none (%ld USB devices visible, none is %04x:%04x%s)",
+                               (long)(n < 0 ? 0 : n), vid, pid, n <= 0 ? "; no USB bus or no access to /dev/bus/usb" : "");
     if (list) libusb_free_device_list(list, 1);
     libusb_exit(ctx);
     return found;
 }
+
+const cbvh_backend_ops cbvh_backend_usb = {"usb", NULL, usb_open, usb_close, usb_run, usb_list};

@@ -34,7 +34,39 @@ static void addr_case(const char *addr, const char *want) {
               err, want);
 }
 
+/* The backend table: the order `cbvh devices` lists and auto probes; each
+ * backend lists under its own name, and a spec names it. */
+static void backend_table_cases(void) {
+    static const char *const order[] = {"usb", "hid", "sim", "model"};
+    size_t n = 0;
+    for (const cbvh_backend_ops *const *o = cbvh_backends; *o; o++, n++) {
+        const cbvh_backend_ops *b = *o;
+        CHECK(n < 4 && strcmp(b->name, order[n]) == 0, "backend %zu is '%s' (want %s)", n, b->name,
+              n < 4 ? order[n] : "the end");
+        CHECK(b->open && b->close && b->run && b->list, "backend '%s' lacks an operation", b->name);
+        char spec[64], err[256] = "";
+        snprintf(spec, sizeof spec, strcmp(b->name, "sim") == 0 ? "%s:unix:/x/b.sock" : "%s", b->name);
+        CHECK(cbvh_backend_spec_check(spec, err, sizeof err) == 0, "spec '%s' refused: %s", spec, err);
+        FILE *f = tmpfile();
+        int found = b->list(NULL, f);
+        rewind(f);
+        char line[512], want[16];
+        snprintf(want, sizeof want, "%s:", b->name);
+        int lines = 0;
+        while (fgets(line, sizeof line, f)) {
+            lines++;
+            CHECK(strncmp(line, want, strlen(want)) == 0 && line[7] != ' ' && line[6] == ' ',
+                  "'%s' listing line not in its column: '%s'", b->name, line);
+        }
+        fclose(f);
+        CHECK(lines >= 1 && found >= 0, "'%s' listed %d lines, found %d", b->name, lines, found);
+        CHECK(strcmp(b->name, "model") != 0 || found == 1, "the model should list itself");
+    }
+    CHECK(n == 4, "%zu backends in the table (want 4)", n);
+}
+
 int main(void) {
+    backend_table_cases();
     /* fault specs: the values the parser takes */
     fault_case("drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1", NULL);
     fault_case("drop=0,delay_ms=0,seed=0", NULL);

@@ -118,7 +118,8 @@ int main(void) {
         CHECK(rc != 0 && strstr(err, want) && !strchr(err, '\n') && dev.enumerates == en && !dev.opened,
               "%s=%s: open gave %d, '%s'", bad[i][0], bad[i][1], rc, err);
         FILE *f = tmpfile();
-        CHECK(cbvh_hid_describe(f) == 0 && dev.enumerates == en, "%s=%s: listing probed anyway", bad[i][0], bad[i][1]);
+        CHECK(cbvh_backend_hid.list(NULL, f) == 0 && dev.enumerates == en, "%s=%s: listing probed anyway", bad[i][0],
+              bad[i][1]);
         char line[300] = "";
         rewind(f);
         CHECK(fgets(line, sizeof line, f) && strncmp(line, "hid:   not probed (", 19) == 0 && strstr(line, want),

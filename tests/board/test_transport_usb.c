@@ -244,10 +244,12 @@ int main(void) {
           dev.claimed);
     /* devices listing */
     FILE *f = tmpfile();
-    CHECK(cbvh_usb_describe(f) == 1, "describe should list one board");
+    CHECK(cbvh_backend_usb.list(NULL, f) == 1, "the listing should name one board");
     rewind(f);
     char buf[256] = "";
-    CHECK(fgets(buf, sizeof buf, f) && strstr(buf, "\"cbvh board\" serial FAKE0001"), "describe: '%s'", buf);
+    CHECK(fgets(buf, sizeof buf, f) && strncmp(buf, "usb:   1209:c0b1 bus ", 21) == 0 &&
+              strstr(buf, "\"cbvh board\" serial FAKE0001"),
+          "listing: '%s'", buf);
     fclose(f);
 
     /* A board that takes 64-byte payloads (IDENTIFY) gets no larger frame:
