@@ -68,7 +68,7 @@ typedef struct {
 } board_thread;
 static void *board_main(void *arg) {
     board_thread *b = arg;
-    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, NULL, 0, 0, NULL};
+    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, NULL, 0, 0, NULL, 0};
     cbvh_sim_board_serve(&o);
     return NULL;
 }
@@ -113,7 +113,7 @@ int main(int argc, char **argv) {
     ip->hal = (cbvh_fw_hal){&ip->regs, cbvh_regmap_model_read, cbvh_regmap_model_write, ip_send, "inproc"};
     cbvh_fw_init(&ip->fw, &ip->hal);
     static cbvh_link link;
-    cbvh_link_io io = {ip, ip_write, ip_read, NULL};
+    cbvh_link_io io = {ip, ip_write, ip_read, NULL, NULL};
     cbvh_link_init(&link, &io);
 
     printf("| unit (N=6) | words in/out | model vec/s | firmware in-process vec/s (x model) | socket board vec/s (x model) | "

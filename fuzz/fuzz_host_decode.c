@@ -33,7 +33,7 @@ static long f_read(void *ctx, uint8_t *buf, size_t cap, int timeout_ms, char *er
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     static cbvh_link l;
     feed f = {data, size};
-    cbvh_link_io io = {&f, f_write, f_read, NULL};
+    cbvh_link_io io = {&f, f_write, f_read, NULL, NULL};
     cbvh_link_init(&l, &io);
     l.seq = 0; /* so inputs can answer seq 1, 2 */
     l.max_retries = 1;

@@ -15,7 +15,8 @@ uint32_t cbvh_crc32(uint32_t crc, const uint8_t *p, size_t n) {
 const char *cbvh_error_name(unsigned code) {
     static const char *const names[] = {"ok",       "crc",     "sync",    "version", "length",
                                         "timeout",  "header",  "command", "payload", "unit",
-                                        "shape",    "too-big", "datapath", "config"};
+                                        "shape",    "too-big", "datapath", "config",
+                                        "busy"};
     return code < sizeof names / sizeof names[0] ? names[code] : "unknown";
 }
 

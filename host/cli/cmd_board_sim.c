@@ -18,10 +18,12 @@ static void on_signal(int sig) {
 }
 
 #define RX_IDLE_MS_MAX 60000
+#define STR_(x) #x
+#define STR(x) STR_(x)
 
 static void usage(FILE *f) {
     fprintf(f, "usage: cbvh board-sim [--listen ADDR] [--gateware PROG] [--faults SPEC] [--rx-idle-ms N]\n"
-               "                      [--break-unit UNIT] [--verbose]\n"
+               "                      [--host-idle-ms N] [--break-unit UNIT] [--verbose]\n"
                "  Runs the virtual board: the firmware core with the bit-exact model as its FPGA,\n"
                "  or with --gateware the board's RTL simulated by Icarus Verilog (PROG from\n"
                "  gateware/scripts/build-board-sim), driven over SPI as on the board;\n"
@@ -31,6 +33,10 @@ static void usage(FILE *f) {
                "  drop=0.01,corrupt=0.01,dup=0.01,trunc=0.01,delay=0.01,disconnect=0.01,delay_ms=150,seed=1\n"
                "  (rates in [0,1] adding up to at most 1, delay_ms 0..10000, seed a non-negative integer).\n"
                "  --rx-idle-ms N: the firmware's inter-byte timeout, 1..60000 (default 20).\n"
+               "  One host at a time: another one is refused at once (\"busy: another host is\n"
+               "  connected\"); --host-idle-ms N lets a host go that sent nothing for N ms, so that\n"
+               "  the next can connect: 0.." STR(CBVH_SIM_HOST_IDLE_MS_MAX) ", 0 never (default "
+               STR(CBVH_SIM_HOST_IDLE_MS_DEFAULT) ").\n"
                "  --break-unit UNIT flips bit 0 of the unit's first output word (a test aid that\n"
                "  plays a gateware bug: checks against this board must fail).\n"
                "  Stops on SIGINT/SIGTERM and removes its socket file.\n"
@@ -47,14 +53,26 @@ static const struct {
     {"--gateware", "a program from gateware/scripts/build-board-sim"},
     {"--faults", "a fault spec, e.g. drop=0.01,seed=1"},
     {"--rx-idle-ms", "an integer in 1..60000"},
+    {"--host-idle-ms", "an integer in 0.." STR(CBVH_SIM_HOST_IDLE_MS_MAX)},
     {"--break-unit", "a unit name, e.g. axis_compress"},
 };
+
+/* An integer option's value in lo..hi: 0, or -1 after the one-line error. */
+static int int_option(const char *opt, const char *val, long lo, long hi, int *out) {
+    long v;
+    if (cbvh_parse_long(val, lo, hi, &v)) {
+        fprintf(stderr, "cbvh board-sim: %s expects an integer in %ld..%ld, got '%s'\n", opt, lo, hi, val);
+        return -1;
+    }
+    *out = (int)v;
+    return 0;
+}
 
 int cmd_board_sim(int argc, char **argv) {
     char def[128];
     snprintf(def, sizeof def, "unix:/tmp/cbvh-board-%u.sock", (unsigned)getuid());
     const char *addr = def, *faults = NULL, *gateware = NULL;
-    int idle = 20, verbose = 0, broken = 0;
+    int idle = 20, host_idle = CBVH_SIM_HOST_IDLE_MS_DEFAULT, verbose = 0, broken = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             usage(stdout);
@@ -83,13 +101,9 @@ int cmd_board_sim(int argc, char **argv) {
         } else if (strcmp(opt, "--faults") == 0) {
             faults = val;
         } else if (strcmp(opt, "--rx-idle-ms") == 0) {
-            long v;
-            if (cbvh_parse_long(val, 1, RX_IDLE_MS_MAX, &v)) {
-                fprintf(stderr, "cbvh board-sim: --rx-idle-ms expects an integer in 1..%d, got '%s'\n",
-                        RX_IDLE_MS_MAX, val);
-                return 2;
-            }
-            idle = (int)v;
+            if (int_option(opt, val, 1, RX_IDLE_MS_MAX, &idle)) return 2;
+        } else if (strcmp(opt, "--host-idle-ms") == 0) {
+            if (int_option(opt, val, 0, CBVH_SIM_HOST_IDLE_MS_MAX, &host_idle)) return 2;
         } else { /* --break-unit */
             const cbvh_unit *u = cbvh_unit_find(val);
             if (!u) {
@@ -132,7 +146,7 @@ int cmd_board_sim(int argc, char **argv) {
     signal(SIGPIPE, SIG_IGN);
     printf("cbvh board-sim: listening on %s\n", addr);
     fflush(stdout);
-    cbvh_sim_board_opts o = {fd, &stop_flag, idle, faults ? &fl : NULL, verbose, broken, gw};
+    cbvh_sim_board_opts o = {fd, &stop_flag, idle, faults ? &fl : NULL, verbose, broken, gw, host_idle};
     int rc = cbvh_sim_board_serve(&o);
     close(fd);
     cbvh_sim_unlink(addr);

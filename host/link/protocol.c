@@ -7,8 +7,8 @@
 #include <string.h>
 #include <time.h>
 
-/* What a request-class error code means, for the one-line message
- * (docs/protocol.md, "Error replies"). */
+/* What a request- or session-class error code means, for the one-line
+ * message (docs/protocol.md, "Error replies"). */
 static const char *request_error_meaning(unsigned code) {
     switch (code) {
     case CBVH_E_HEADER: return "the request's status byte was not 0";
@@ -19,6 +19,7 @@ static const char *request_error_meaning(unsigned code) {
     case CBVH_E_TOO_BIG: return "the reply would not fit one frame";
     case CBVH_E_DATAPATH: return "the datapath did not finish or flagged an error";
     case CBVH_E_CONFIG: return "the board's unit is not built for this N, min_scale or encoding";
+    case CBVH_E_BUSY: return "another host is connected";
     default: return "unknown code";
     }
 }
@@ -67,10 +68,30 @@ int cbvh_link_env_options(cbvh_link *l, char *err, size_t errlen) {
 void cbvh_link_flush(cbvh_link *l, int quiet_ms) {
     uint8_t buf[4096];
     char err[64];
-    if (!l->broken)
-        while (l->io.read(l->io.ctx, buf, sizeof buf, quiet_ms, err, sizeof err) > 0) {}
+    long r;
+    cbvh_parser_init(&l->rx);
+    while (!l->broken && (r = l->io.read(l->io.ctx, buf, sizeof buf, quiet_ms, err, sizeof err)) > 0)
+        for (size_t off = 0; off < (size_t)r || cbvh_parser_busy(&l->rx);) { /* dropped, but a refusal is kept */
+            size_t used = 0;
+            cbvh_frame f;
+            cbvh_parse_error e;
+            if (cbvh_parser_push(&l->rx, buf + off, (size_t)r - off, &used, &f, &e) == CBVH_PARSE_FRAME &&
+                f.status == CBVH_E_BUSY)
+                l->refused = 1;
+            off += used;
+        }
     cbvh_parser_init(&l->rx);
     l->pend_len = 0;
+}
+
+/* The board refused the connection (busy): final, and the connection is
+ * gone; the next request connects again. */
+static int fail_refused(cbvh_link *l, char *err, size_t errlen) {
+    l->refused = 0;
+    l->broken = 1;
+    l->st.failures++;
+    snprintf(err, errlen, "%s: %s", cbvh_error_name(CBVH_E_BUSY), request_error_meaning(CBVH_E_BUSY));
+    return -1;
 }
 
 /* Reopens a broken link, trying again after a short, growing pause until the
@@ -146,12 +167,19 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
     char why[300] = "no attempt made";
     for (int attempt = 0; attempt <= l->max_retries; attempt++) {
         if (attempt) l->st.retries++;
+        if (!l->broken && l->io.hung_up && l->io.hung_up(l->io.ctx)) {
+            cbvh_link_flush(l, 0); /* what the board said before it hung up: a refusal? */
+            l->st.link_breaks++;
+            l->broken = 1;
+        }
+        if (l->refused) return fail_refused(l, err, errlen);
         if (l->broken) {
             if (!l->io.reopen) break; /* nothing can bring the link back */
             if (reopen_within_timeout(l, why, sizeof why) != 0) continue;
             l->broken = 0;
             l->st.reopens++;
             cbvh_link_flush(l, 5);
+            if (l->refused) return fail_refused(l, err, errlen);
         }
         l->st.attempts++;
         if (l->io.write(l->io.ctx, l->tx, n, why, sizeof why) != 0) {
@@ -202,6 +230,7 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
                     }
                 } else if (ev == CBVH_PARSE_FRAME) {
                     got.frame_bytes += CBVH_FRAME_HDR + f.len + CBVH_FRAME_CRC;
+                    if (f.status == CBVH_E_BUSY) return fail_refused(l, err, errlen); /* whatever it answers */
                     if (f.cmd != (cmd | CBVH_REPLY) || f.seq != seq) {
                         l->st.stale_replies++;
                         got.stale_frames++;

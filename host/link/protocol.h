@@ -21,6 +21,10 @@ typedef struct {
     long (*read)(void *ctx, uint8_t *buf, size_t cap, int timeout_ms, char *err, size_t errlen);
     /* Re-establishes a broken link (NULL: cannot). 0 or -1. */
     int (*reopen)(void *ctx, char *err, size_t errlen);
+    /* 1 when the other end has closed the link (the virtual board lets an
+     * idle host go), checked before each request so that it is reopened
+     * without spending an attempt; NULL: never known in advance. */
+    int (*hung_up)(void *ctx);
 } cbvh_link_io;
 
 typedef struct {
@@ -38,6 +42,7 @@ typedef struct {
     int max_retries; /* attempts = 1 + max_retries */
     uint16_t seq;
     int broken;
+    int refused; /* the board refused this connection: another host has it (CBVH_E_BUSY) */
     cbvh_link_stats st;
     cbvh_parser rx;
     uint8_t tx[CBVH_FRAME_MAX];
@@ -54,14 +59,17 @@ typedef struct {
 #define CBVH_LINK_RETRIES_MAX 1000
 
 void cbvh_link_init(cbvh_link *l, const cbvh_link_io *io);
-/* Drops whatever the board still has in flight (after open/reopen). */
+/* Drops whatever the board still has in flight (after open/reopen), except
+ * a refusal (status busy), which the next request reports at once. */
 void cbvh_link_flush(cbvh_link *l, int quiet_ms);
 
 /* One request/reply exchange with retries.  On success returns 0 and the
  * reply payload is in l->reply[0..*reply_len).  Error replies that are not
  * link errors are final (no retry).  A broken link is reopened, tried again
  * with a short back-off for up to timeout_ms per attempt (a board reset or
- * USB re-enumeration takes about a second).  On failure err ends with what
+ * USB re-enumeration takes about a second).  A refusal (status busy: the
+ * virtual board serves another host) fails at once with "busy: another host
+ * is connected", before or instead of any reply.  On failure err ends with what
  * the last attempt saw: nothing, garbage, another protocol version, a frame
  * cut short or damaged, only stale frames, or a link that did not come back. */
 int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16_t len, uint16_t *reply_len,

@@ -86,7 +86,7 @@ static int hid_open_board(cbvh_backend *b, const char *arg, char *err, size_t er
         snprintf(err, errlen, "out of memory");
         return CBVH_BACKEND_ERROR;
     }
-    cbvh_link_io io = {s, hidt_write, hidt_read, hidt_reopen};
+    cbvh_link_io io = {s, hidt_write, hidt_read, hidt_reopen, NULL};
     cbvh_link_init(&s->link, &io);
     /* Bad settings fail the open before any device is looked for. */
     if (cbvh_usb_identity(&s->vid, &s->pid, err, errlen) || cbvh_link_env_options(&s->link, err, errlen)) {

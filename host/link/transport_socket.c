@@ -53,6 +53,15 @@ static int sock_reopen(void *ctx, char *err, size_t errlen) {
     return s->fd < 0 ? -1 : 0;
 }
 
+/* The board closed the connection (it lets a host go that sent nothing for
+ * its --host-idle-ms): the next request reconnects first. */
+static int sock_hung_up(void *ctx) {
+    sim_state *s = ctx;
+    if (s->fd < 0) return 1;
+    struct pollfd p = {s->fd, POLLRDHUP, 0};
+    return poll(&p, 1, 0) > 0 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR));
+}
+
 /* A wrong address is reported as such, not as "no board (start one with
  * ...)" with a hint that would fail the same way. */
 static int sim_check_arg(const char *arg, char *err, size_t errlen) {
@@ -71,7 +80,7 @@ static int sim_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         snprintf(err, errlen, "out of memory");
         return CBVH_BACKEND_ERROR;
     }
-    cbvh_link_io io = {s, sock_write, sock_read, sock_reopen};
+    cbvh_link_io io = {s, sock_write, sock_read, sock_reopen, sock_hung_up};
     cbvh_link_init(&s->link, &io);
     if (cbvh_link_env_options(&s->link, err, errlen)) {
         free(s);

@@ -126,7 +126,7 @@ static int usb_open(cbvh_backend *b, const char *arg, char *err, size_t errlen) 
         return CBVH_BACKEND_ERROR;
     }
     if (arg) snprintf(s->serial, sizeof s->serial, "%s", arg);
-    cbvh_link_io io = {s, usb_write, usb_read, usb_reopen};
+    cbvh_link_io io = {s, usb_write, usb_read, usb_reopen, NULL};
     cbvh_link_init(&s->link, &io);
     /* Bad settings fail the open before any device is looked for. */
     if (cbvh_usb_identity(&s->vid, &s->pid, err, errlen) || cbvh_link_env_options(&s->link, err, errlen)) {

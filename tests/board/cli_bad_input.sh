@@ -4,7 +4,7 @@
 # part, nothing ignored).  A board-sim that does start (on a private socket)
 # is killed after 5 s, which fails the case.
 # Usage: cli_bad_input.sh PATH/TO/cbvh GROUP VECTOR-DIR
-#   GROUP: listen, rx_idle, faults, env, devices_sim, gateware, options, backend; VECTOR-DIR: a valid one, so
+#   GROUP: listen, rx_idle, host_idle, faults, env, devices_sim, gateware, options, backend; VECTOR-DIR: a valid one, so
 #   that `vectors check` gets as far as opening its backend
 set -u
 cbvh=$1
@@ -51,6 +51,19 @@ rx_idle)
     expect 2 "got '0'" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms 0
     expect 2 "got '60001'" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms 60001
     expect 2 "got ''" -- board-sim --listen "unix:$tmp/b.sock" --rx-idle-ms ""
+    ;;
+host_idle)
+    expect 2 "cbvh board-sim: --host-idle-ms expects an integer in 0..3600000, got '5x'" \
+        -- board-sim --listen "unix:$tmp/b.sock" --host-idle-ms 5x
+    expect 2 "got '-1'" -- board-sim --listen "unix:$tmp/b.sock" --host-idle-ms -1
+    expect 2 "got '3600001'" -- board-sim --listen "unix:$tmp/b.sock" --host-idle-ms 3600001
+    expect 2 "got ''" -- board-sim --listen "unix:$tmp/b.sock" --host-idle-ms ""
+    expect 2 "cbvh board-sim: --host-idle-ms needs a value (an integer in 0..3600000)" -- board-sim --host-idle-ms
+    if "$cbvh" board-sim --help | tr '\n' ' ' | grep -q -- "--host-idle-ms N lets a host go .* 0 never (default 10000)"; then
+        echo "ok: board-sim --help documents --host-idle-ms and its default"
+    else
+        echo "FAIL: board-sim --help does not document --host-idle-ms and its default"; fails=$((fails + 1))
+    fi
     ;;
 faults)
     expect 2 "--faults: fault spec item 'drop=nan': bad value, expected a probability in [0,1]" -- board-sim --listen "unix:$tmp/b.sock" --faults drop=nan

@@ -178,6 +178,11 @@ static void error_classes(void **s) {
     assert_false(cbvh_error_is_link(CBVH_E_OK));
     assert_string_equal(cbvh_error_name(CBVH_E_SHAPE), "shape");
     assert_string_equal(cbvh_error_name(200), "unknown");
+    /* the virtual board's refusal (docs/protocol.md): code 14, final, not retried */
+    assert_int_equal(CBVH_E_BUSY, 14);
+    assert_false(cbvh_error_is_link(CBVH_E_BUSY));
+    assert_string_equal(cbvh_error_name(CBVH_E_BUSY), "busy");
+    assert_string_equal(cbvh_error_name(CBVH_E_BUSY + 1), "unknown");
 }
 
 int main(void) {

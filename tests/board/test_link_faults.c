@@ -28,7 +28,7 @@ typedef struct {
 
 static void *board_main(void *arg) {
     board_thread *b = arg;
-    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, &b->reply_faults, 0, 0, NULL};
+    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, &b->reply_faults, 0, 0, NULL, 0};
     cbvh_sim_board_serve(&o);
     return NULL;
 }

@@ -50,7 +50,7 @@ typedef struct {
 
 static void *board_main(void *arg) {
     board_thread *b = arg;
-    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, NULL, 0, 0, NULL};
+    cbvh_sim_board_opts o = {b->fd, &b->stop, 20, NULL, 0, 0, NULL, 0};
     cbvh_sim_board_serve(&o);
     return NULL;
 }
@@ -228,7 +228,7 @@ static long sb_read(void *ctx, uint8_t *buf, size_t cap, int timeout_ms, char *e
 static void reply_case(reply_kind kind, const char *want, const char *must_not) {
     static cbvh_link l;
     script_board sb = {kind, {0}, 0, 0};
-    cbvh_link_io io = {&sb, sb_write, sb_read, NULL};
+    cbvh_link_io io = {&sb, sb_write, sb_read, NULL, NULL};
     cbvh_link_init(&l, &io);
     l.timeout_ms = 40;
     l.max_retries = 1;

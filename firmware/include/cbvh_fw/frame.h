@@ -49,6 +49,8 @@ enum {
     CBVH_E_TOO_BIG = 11,   /* batch exceeds one frame */
     CBVH_E_DATAPATH = 12,  /* datapath did not finish / flagged an error */
     CBVH_E_CONFIG = 13,    /* unit present but not built for this N / min_scale / encoding */
+    CBVH_E_BUSY = 14,      /* session: the virtual board serves another host; sent unprompted
+                              (command 0x80, sequence number 0) on a connection it then closes */
 };
 
 static inline int cbvh_error_is_link(unsigned code) { return code >= CBVH_E_CRC && code <= CBVH_E_TIMEOUT; }

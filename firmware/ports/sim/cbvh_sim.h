@@ -59,12 +59,19 @@ typedef struct {
     int verbose;
     int broken_unit;          /* see cbvh_regmap_model.broken_unit */
     cbvh_gateware *gateware;  /* the FPGA as simulated RTL, or NULL for the model */
+    int host_idle_ms;         /* a host that sends nothing for this long is let go; 0: never */
 } cbvh_sim_board_opts;
 
+/* board-sim's --host-idle-ms unless given (docs/protocol.md, "Virtual board"). */
+#define CBVH_SIM_HOST_IDLE_MS_DEFAULT 10000
+#define CBVH_SIM_HOST_IDLE_MS_MAX 3600000
+
 /* Accepts one connection at a time and runs the firmware core on it until
- * *stop.  Returns 0, or -1 on a listening-socket error or a failed gateware
- * simulation, including a transaction abandoned by *stop (cbvh_gateware_error
- * says why). */
+ * *stop.  Another host that connects meanwhile is refused at once: an error
+ * frame with status busy (CBVH_E_BUSY), then the connection is closed.  A
+ * host that sends nothing for host_idle_ms is disconnected.  Returns 0, or -1
+ * on a listening-socket error or a failed gateware simulation, including a
+ * transaction abandoned by *stop (cbvh_gateware_error says why). */
 int cbvh_sim_board_serve(const cbvh_sim_board_opts *o);
 
 #endif
