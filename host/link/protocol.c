@@ -168,9 +168,20 @@ int cbvh_link_transact(cbvh_link *l, uint8_t cmd, const uint8_t *payload, uint16
     for (int attempt = 0; attempt <= l->max_retries; attempt++) {
         if (attempt) l->st.retries++;
         if (!l->broken && l->io.hung_up && l->io.hung_up(l->io.ctx)) {
-            cbvh_link_flush(l, 0); /* what the board said before it hung up: a refusal? */
+            /* The board closed the link: it let this host go after an idle
+             * time, or it went away.  Reconnect at once, without spending an
+             * attempt; a board that is not there spends this one, as the
+             * write that finds the link broken would. */
+            cbvh_link_flush(l, 0); /* what it said before it hung up: a refusal? */
+            if (l->refused) return fail_refused(l, err, errlen);
             l->st.link_breaks++;
-            l->broken = 1;
+            if (!l->io.reopen || l->io.reopen(l->io.ctx, why, sizeof why) != 0) {
+                l->broken = 1;
+                l->st.attempts++;
+                continue;
+            }
+            l->st.reopens++;
+            cbvh_link_flush(l, 5);
         }
         if (l->refused) return fail_refused(l, err, errlen);
         if (l->broken) {
