@@ -29,6 +29,9 @@ ok() { echo "ok: $*"; }
 start_board() {
     sock=$1
     shift
+    # emptied here, not only by the child's redirection: the wait below must
+    # not find the previous board's "listening on" before the child has run
+    : >"$tmp/board.out"
     "$cbvh" board-sim --listen "unix:$sock" "$@" >"$tmp/board.out" 2>"$tmp/board.err" &
     bpid=$!
     pids="$pids $bpid"
