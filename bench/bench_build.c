@@ -1,6 +1,6 @@
-/* Build benchmark (issue 3): float LBVH throughput, streaming bottom-up CBVH
- * build vs the float LBVH build in the same run, top-down compression, and
- * CBVH bytes vs float BVH bytes.
+/* Build benchmark (the builders' throughput targets): float LBVH throughput,
+ * streaming bottom-up CBVH build vs the float LBVH build in the same run,
+ * top-down compression, and CBVH bytes vs float BVH bytes.
  *
  * usage: bench_build [--reps R] [--warm] [--json FILE] [SCENE...]
  *   SCENE as for `cbvh study` (file or proc:NAME[:SIZE]); default: the bundled
