@@ -1,6 +1,6 @@
-/* Build benchmark (issue 3): float LBVH throughput, streaming bottom-up CBVH
- * build vs the float LBVH build in the same run, top-down compression, and
- * CBVH bytes vs float BVH bytes.
+/* Build benchmark (the builders' throughput targets): float LBVH throughput,
+ * streaming bottom-up CBVH build vs the float LBVH build in the same run,
+ * top-down compression, and CBVH bytes vs float BVH bytes.
  *
  * usage: bench_build [--reps R] [--warm] [--json FILE] [SCENE...]
  *   SCENE as for `cbvh study` (file or proc:NAME[:SIZE]); default: the bundled
@@ -10,7 +10,7 @@
  *   already touched.  Without it every large buffer is fresh memory, and on
  *   a VM whose host backs a page at first touch that cost (measured up to
  *   ~12 us per 4 KiB page) lands in both sides of every ratio
- *   (docs/results.md, "Fused LBVH + streaming compression").
+ *   (docs/results.md, "Build throughput").
  *   --json FILE: the same figures for machines, written to FILE (temporary
  *   file, then renamed, so a failed run leaves no half-written FILE).
  * Times are the best of R repetitions (default 3), one core.  Both sides of
@@ -31,7 +31,7 @@
  * stack, no records, no packing, no backtracking, no inner children.  Any
  * scalar step built on these fast paths does at least that, so
  * min_fused = 1 + arith_ms / lbvh_ms (bests) is a floor under fused/lbvh
- * (docs/results.md, "A floor under the fused build"). */
+ * (docs/results.md, "Build throughput": the floor). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <limits.h>

@@ -1,5 +1,5 @@
-/* Traversal benchmark (issue 4, "Performance"): on the same scene and the same
- * rays in one run, single-ray throughput of
+/* Traversal benchmark (the throughput targets against Embree): on the same
+ * scene and the same rays in one run, single-ray throughput of
  *   - Embree 3 rtcIntersect1 / rtcOccluded1 (the baseline; if built with it),
  *   - the float BVH with a plain floating-point traversal (conservative
  *     binary64 slab test, the triangle unit: cbvh_trace_bvh_float),

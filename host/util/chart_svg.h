@@ -1,4 +1,4 @@
-/* A small SVG line-chart writer for the accuracy-vs-cost studies (issue 4:
+/* A small SVG line-chart writer for the accuracy-vs-cost studies (cbvh sweep:
  * x = coordinate bits N, y = cost relative to the float BVH, one series per
  * quantity or effect).  Axes with ticks and labels, a legend, one polyline
  * with point markers per series.  Written to a temporary file and renamed.

@@ -1,4 +1,4 @@
-/* PNG output for the studies (issue 4: per-pixel heat maps, rendered images):
+/* PNG output for the studies (cbvh sweep: per-pixel heat maps, rendered images):
  * 8-bit grey or RGB through libpng, written to a temporary file and renamed,
  * so a failed write never leaves a half-written image.  Every failure is a
  * one-line message in err and -1. */

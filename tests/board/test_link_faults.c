@@ -193,7 +193,7 @@ int main(int argc, char **argv) {
                        name, rate, (unsigned long long)r.frames, (unsigned long long)injected, inj,
                        (unsigned long long)det, dt, (unsigned long long)s->retries, r.batches_failed, r.batches,
                        r.vectors_ok, r.wrong);
-            /* The properties the issue asks for. */
+            /* What the link guarantees: no wrong answer, every vector accounted for. */
             if (r.wrong) fprintf(stderr, "FAIL: %s %.3g: %zu wrong vectors reported as answered\n", name, rate, r.wrong), fails++;
             if (r.vectors_ok + r.batches_failed * per != r.batches * per)
                 fprintf(stderr, "FAIL: %s: vectors unaccounted for\n", name), fails++;

@@ -1,4 +1,4 @@
-/* Scenes, float builders and CBVH compressors (issue 3). */
+/* Scenes, float builders and CBVH compressors (docs/study.md). */
 #define _POSIX_C_SOURCE 200809L /* mkfifo */
 #include <float.h>
 #include <math.h>

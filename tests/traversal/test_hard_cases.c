@@ -1,5 +1,5 @@
-/* Traversal hard cases (issue 4, "Hard cases (named tests)"), one ctest each:
- * traversal.hard.<case>.  Every case builds a small scene in memory, builds
+/* Traversal hard cases (docs/traversal.md §8: the named cases every traversal
+ * must get right), one ctest each: traversal.hard.<case>.  Every case builds a small scene in memory, builds
  * float BVHs (SAH and LBVH) and CBVHs (top-down and bottom-up, both
  * encodings, several N / M) and traces rays through all of them:
  *   - CBVH closest hit == float-BVH closest hit (prim, t, b1, b2 bits)

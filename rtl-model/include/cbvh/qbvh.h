@@ -20,9 +20,10 @@
 
 /* 5-comparator sorting network (pairs (0,1) (2,3) (0,2) (1,3) (1,2)) on the key
  * (missed, t, index): hit children first, by t (binary32 total order, -0 = +0),
- * ties by child index.  t of a missed child is ignored.  order[0] is the
- * nearest child; *nhit = number of hit children.  Status: NAN_INF if a hit
- * child's t is NaN, BAD_PARAM if hit_mask > 15 (then every output is 0). */
+ * ties by child index; then the missed children by child index alone (their
+ * t is never read).  order[0] is the nearest child; *nhit = number of hit
+ * children.  Status: BAD_PARAM if hit_mask > 15 (checked first), else
+ * NAN_INF if a hit child's t is NaN; every output 0 then (docs/qbvh.md §2). */
 uint32_t cbvh_qstack_sort(const uint32_t t[4], uint32_t hit_mask, uint8_t order[4], int *nhit);
 
 /* Push: the entry for the deferred children order[1 .. nhit-1] (nhit >= 2;
