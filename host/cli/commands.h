@@ -22,6 +22,10 @@ int cmd_sweep(int argc, char **argv);     /* cmd_sweep.c: accuracy vs time over 
  * opterr = 0): one line naming it, instead of getopt's own message (which
  * names the subcommand as if it were the program) and the whole usage. */
 int cbvh_bad_option(const char *cmd, char **argv, int optind_now); /* main.c; returns 2 */
+/* The same for a command that names a missing value itself (getopt_long's
+ * ':' with a leading ':' in the option string): "CMD: unknown option 'X'
+ * (see CMD --help)". */
+int cbvh_unknown_option(const char *cmd, char **argv, int optind_now); /* main.c; returns 2 */
 
 /* A cost a relative to the float BVH's b.  Where the float BVH did none
  * (b = 0): NaN when neither did (0/0 is no ratio, not 1), infinity when only

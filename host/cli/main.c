@@ -36,6 +36,11 @@ int cbvh_bad_option(const char *cmd, char **argv, int optind_now) {
     return 2;
 }
 
+int cbvh_unknown_option(const char *cmd, char **argv, int optind_now) {
+    fprintf(stderr, "%s: unknown option '%s' (see %s --help)\n", cmd, optind_now > 0 ? argv[optind_now - 1] : "", cmd);
+    return 2;
+}
+
 /* Results go to stdout, often redirected: a full disk or a closed pipe must
  * not pass as success with the table or JSON lost.  Exit 2 unless the command
  * already failed. */
