@@ -618,13 +618,19 @@ done:
 /* assimp's glTF importers drop faces with out-of-range indices, and the
  * indices left over when a triangle list is not a multiple of 3, with only a
  * log warning ("... were dropped."), as its PLY reader does for a record it
- * cannot parse (it reads zeros); a warning like those fails the import. */
+ * cannot parse (it reads zeros) and its OBJ reader for an 'f' line without
+ * indices (an error in the log, "Ignoring empty face", and none in the
+ * result); a message like those fails the import. */
 typedef struct {
     char msg[200];
 } dropped_note;
 
 static void note_dropped(const char *message, char *user) {
     dropped_note *d = (dropped_note *)user;
+    if (!d->msg[0] && strstr(message, "Ignoring empty face")) {
+        snprintf(d->msg, sizeof d->msg, "a face with no vertices (an 'f' line without indices), which the importer drops");
+        return;
+    }
     if (d->msg[0] || strncmp(message, "Warn", 4) != 0 ||
         !(strstr(message, " were dropped") || strstr(message, "Unable to parse property instance")))
         return;
