@@ -437,7 +437,7 @@ int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *d
         return -1;
     }
     /* cJSON ends a string at a \u0000 escape: "a.obj\u0000x" would load a.obj. */
-    size_t len = strlen(text), nul = cbvh_json_nul_escape(text, len);
+    size_t len = strlen(text), nul = cbvh_json_find_nul(text, len);
     if (nul < len) {
         cJSON_Delete(root);
         fail(&c, NULL, "line %d: a string holds \\u0000 (NUL), which no name or path can hold", line_at(text, text + nul));

@@ -56,13 +56,14 @@ int cbvh_json_print(const cJSON *root, FILE *f) {
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }
 
-size_t cbvh_json_nul_escape(const char *text, size_t len) {
+size_t cbvh_json_find_nul(const char *text, size_t len) {
     /* Outside strings a backslash is not JSON at all (the parser refuses it),
      * so every backslash starts an escape: step over each, "\\" included. */
-    for (size_t i = 0; i + 1 < len; i++)
-        if (text[i] == '\\') {
-            if (text[i + 1] == 'u' && i + 6 <= len && strncmp(text + i + 2, "0000", 4) == 0) return i;
-            i++;
-        }
+    for (size_t i = 0; i < len; i++) {
+        if (!text[i]) return i;
+        if (text[i] != '\\' || i + 1 == len || !text[i + 1]) continue;
+        if (text[i + 1] == 'u' && i + 6 <= len && strncmp(text + i + 2, "0000", 4) == 0) return i;
+        i++;
+    }
     return len;
 }

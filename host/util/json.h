@@ -32,9 +32,9 @@ void cbvh_json_str(const char *s, FILE *f);
  * cbvh_out_of_memory. */
 int cbvh_json_print(const cJSON *root, FILE *f);
 
-/* The offset in text (len bytes of JSON) of the first \u0000 escape inside a
- * string, or len if none.  cJSON decodes it to a NUL that ends the string
- * there: "a.obj\u0000x" would read as "a.obj". */
-size_t cbvh_json_nul_escape(const char *text, size_t len);
+/* The offset in text (len bytes of JSON) of the first NUL, a raw byte or a
+ * \u0000 escape inside a string, or len if none.  cJSON keeps it in the
+ * string, where it ends the C string: "a.obj\u0000x" would read as "a.obj". */
+size_t cbvh_json_find_nul(const char *text, size_t len);
 
 #endif
