@@ -1,4 +1,5 @@
 /* cbvh board-sim: run the virtual board (firmware core, sim port) on a socket. */
+#include <getopt.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,17 +46,20 @@ static void usage(FILE *f) {
                "  or a stop abandoned a gateware transaction in progress); 2 bad options or values.\n");
 }
 
-/* What each option's value is, for the one-line error when it is missing. */
+/* Each option with a value, and what its value is, for the one-line error
+ * when it is missing. */
 static const struct {
-    const char *name, *value;
+    struct option opt;
+    const char *value;
 } valued_options[] = {
-    {"--listen", "unix:PATH or tcp:HOST:PORT"},
-    {"--gateware", "a program from gateware/scripts/build-board-sim"},
-    {"--faults", "a fault spec, e.g. drop=0.01,seed=1"},
-    {"--rx-idle-ms", "an integer in 1..60000"},
-    {"--host-idle-ms", "an integer in 0.." STR(CBVH_SIM_HOST_IDLE_MS_MAX)},
-    {"--break-unit", "a unit name, e.g. axis_compress"},
+    {{"listen", required_argument, 0, 'l'}, "unix:PATH or tcp:HOST:PORT"},
+    {{"gateware", required_argument, 0, 'g'}, "a program from gateware/scripts/build-board-sim"},
+    {{"faults", required_argument, 0, 'f'}, "a fault spec, e.g. drop=0.01,seed=1"},
+    {{"rx-idle-ms", required_argument, 0, 'r'}, "an integer in 1..60000"},
+    {{"host-idle-ms", required_argument, 0, 'H'}, "an integer in 0.." STR(CBVH_SIM_HOST_IDLE_MS_MAX)},
+    {{"break-unit", required_argument, 0, 'u'}, "a unit name, e.g. axis_compress"},
 };
+#define NVALUED (sizeof valued_options / sizeof valued_options[0])
 
 /* An integer option's value in lo..hi: 0, or -1 after the one-line error. */
 static int int_option(const char *opt, const char *val, long lo, long hi, int *out) {
@@ -73,45 +77,49 @@ int cmd_board_sim(int argc, char **argv) {
     snprintf(def, sizeof def, "unix:/tmp/cbvh-board-%u.sock", (unsigned)getuid());
     const char *addr = def, *faults = NULL, *gateware = NULL;
     int idle = 20, host_idle = CBVH_SIM_HOST_IDLE_MS_DEFAULT, verbose = 0, broken = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            usage(stdout);
-            return 0;
-        }
-        if (strcmp(argv[i], "--verbose") == 0) {
-            verbose = 1;
-            continue;
-        }
-        const char *value_is = NULL;
-        for (size_t k = 0; k < sizeof valued_options / sizeof valued_options[0]; k++)
-            if (strcmp(argv[i], valued_options[k].name) == 0) value_is = valued_options[k].value;
-        if (!value_is) {
-            fprintf(stderr, "cbvh board-sim: unknown option '%s' (cbvh board-sim --help)\n", argv[i]);
-            return 2;
-        }
-        if (i + 1 >= argc) {
-            fprintf(stderr, "cbvh board-sim: %s needs a value (%s)\n", argv[i], value_is);
-            return 2;
-        }
-        const char *opt = argv[i], *val = argv[++i];
-        if (strcmp(opt, "--listen") == 0) {
-            addr = val;
-        } else if (strcmp(opt, "--gateware") == 0) {
-            gateware = val;
-        } else if (strcmp(opt, "--faults") == 0) {
-            faults = val;
-        } else if (strcmp(opt, "--rx-idle-ms") == 0) {
-            if (int_option(opt, val, 1, RX_IDLE_MS_MAX, &idle)) return 2;
-        } else if (strcmp(opt, "--host-idle-ms") == 0) {
-            if (int_option(opt, val, 0, CBVH_SIM_HOST_IDLE_MS_MAX, &host_idle)) return 2;
-        } else { /* --break-unit */
-            const cbvh_unit *u = cbvh_unit_find(val);
-            if (!u) {
-                fprintf(stderr, "cbvh board-sim: --break-unit: unknown unit '%s'\n", val);
+    struct option lo[NVALUED + 3] = {{"help", no_argument, 0, 'h'}, {"verbose", no_argument, 0, 'v'}};
+    for (size_t k = 0; k < NVALUED; k++) lo[2 + k] = valued_options[k].opt;
+    int c;
+    const cbvh_unit *u;
+    optind = 0;
+    opterr = 0;
+    /* "-": an argument that is not an option comes back as 1 (and is refused);
+     * ":": a missing value is ':' */
+    while ((c = getopt_long(argc, argv, "-:h", lo, NULL)) != -1) {
+        switch (c) {
+        case 'h': usage(stdout); return 0;
+        case 'v': verbose = 1; break;
+        case 'l': addr = optarg; break;
+        case 'g': gateware = optarg; break;
+        case 'f': faults = optarg; break;
+        case 'r':
+            if (int_option("--rx-idle-ms", optarg, 1, RX_IDLE_MS_MAX, &idle)) return 2;
+            break;
+        case 'H':
+            if (int_option("--host-idle-ms", optarg, 0, CBVH_SIM_HOST_IDLE_MS_MAX, &host_idle)) return 2;
+            break;
+        case 'u':
+            if (!(u = cbvh_unit_find(optarg))) {
+                fprintf(stderr, "cbvh board-sim: --break-unit: unknown unit '%s'\n", optarg);
                 return 2;
             }
             broken = u->id;
+            break;
+        case ':':
+            for (size_t k = 0; k < NVALUED; k++)
+                if (valued_options[k].opt.val == optopt)
+                    fprintf(stderr, "cbvh board-sim: --%s needs a value (%s)\n", valued_options[k].opt.name,
+                            valued_options[k].value);
+            return 2;
+        default: /* an unknown option, or an argument (1) */
+            fprintf(stderr, "cbvh board-sim: unknown option '%s' (cbvh board-sim --help)\n",
+                    c == 1 ? optarg : argv[optind - 1]);
+            return 2;
         }
+    }
+    if (optind < argc) { /* after "--" */
+        fprintf(stderr, "cbvh board-sim: unknown option '%s' (cbvh board-sim --help)\n", argv[optind]);
+        return 2;
     }
     char err[256];
     cbvh_link_fault fl;

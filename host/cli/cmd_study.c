@@ -1,5 +1,6 @@
 /* cbvh study: the backtracking and memory-traffic study of Viitanen et al.
  * (Table 1 and Fig. 10) on real and procedural scenes.  docs/study.md. */
+#include <getopt.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -209,23 +210,67 @@ out:
     return rc;
 }
 
-/* Scene names are file names: any bytes (commands.h). */
-static void json_str(const char *s) { cbvh_json_str(s, stdout); }
-
-static void json_num(double x) {
-    if (isnan(x))
-        printf("null");
-    else
-        printf("%.6g", x);
+/* --json numbers as the table's precision (%.6g), NaN (no ratio) as null. */
+static cJSON *json_num(double x) {
+    if (isnan(x)) return cJSON_CreateNull();
+    char buf[32];
+    snprintf(buf, sizeof buf, "%.6g", x);
+    return cJSON_CreateNumber(strtod(buf, NULL));
 }
 
-static void json_arr(const double *v, int n) {
-    putchar('[');
-    for (int i = 0; i < n; i++) {
-        if (i) putchar(',');
-        json_num(v[i]);
+static cJSON *json_arr(const double *v, int n) {
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; i < n; i++) cJSON_AddItemToArray(a, json_num(v[i]));
+    return a;
+}
+
+static cJSON *json_counts(const uint64_t *v, int n) {
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; i < n; i++) cJSON_AddItemToArray(a, cJSON_CreateNumber((double)v[i]));
+    return a;
+}
+
+static void json_write(const scene_result *res, const sweep_result *sw, int ns, int sweep, cbvh_params p) {
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddNumberToObject(root, "quant_bits", p.quant_bits);
+    cJSON_AddNumberToObject(root, "min_scale", p.min_scale);
+    cJSON_AddItemToObject(root, "configs", cJSON_CreateStringArray(cfg_name, NCFG));
+    cJSON *tm = cJSON_AddObjectToObject(root, "traffic_model");
+    cJSON_AddNumberToObject(tm, "input", TR_INPUT);
+    cJSON_AddNumberToObject(tm, "sort", TR_SORT);
+    cJSON_AddNumberToObject(tm, "float_pair", TR_FLOAT_PAIR);
+    cJSON_AddNumberToObject(tm, "id", TR_ID);
+    cJSON_AddNumberToObject(tm, "backtrack", TR_BACKTRACK);
+    cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
+    for (int i = 0; i < ns; i++) {
+        const scene_result *r = &res[i];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(scenes, o);
+        cJSON_AddStringToObject(o, "name", r->scene_name);
+        cJSON_AddStringToObject(o, "spec", r->spec);
+        cJSON_AddNumberToObject(o, "triangles", r->tris);
+        cJSON_AddNumberToObject(o, "leaves", r->leaves);
+        cJSON_AddNumberToObject(o, "node_pairs", r->pairs);
+        cJSON_AddItemToObject(o, "prims_per_leaf", json_num(r->prims_per_leaf));
+        cJSON_AddItemToObject(o, "sah_cbvh_over_float", json_num(r->sah_ratio));
+        cJSON_AddItemToObject(o, "sah_cbvh_over_float_sah_builder", json_num(r->sah_ratio_sah_builder));
+        cJSON_AddNumberToObject(o, "cbvh_bytes", (double)r->cbvh_bytes);
+        cJSON_AddNumberToObject(o, "float_bvh_bytes", (double)r->bvh_bytes);
+        cJSON_AddStringToObject(o, "refit_deformation", r->deform);
+        cJSON_AddItemToObject(o, "backtracks_lbvh", json_counts(r->bt_lbvh, NCFG));
+        cJSON_AddItemToObject(o, "backtracks_refit", json_counts(r->bt_refit, NCFG));
+        cJSON_AddItemToObject(o, "backtracks_norm", json_arr(r->norm_bt, NCFG));
+        cJSON_AddItemToObject(o, "traffic_lbvh_norm", json_arr(r->mem_lbvh, NCFG + 1));
+        cJSON_AddItemToObject(o, "traffic_refit_norm", json_arr(r->mem_refit, NCFG + 1));
+        if (sweep) {
+            cJSON *j = cJSON_AddObjectToObject(o, "sweep");
+            cJSON_AddItemToObject(j, "min_scale", cJSON_CreateIntArray(sweep_scales, NSWEEP));
+            cJSON_AddItemToObject(j, "backtracks_per_prim", json_arr(sw[i].bt_per_prim, NSWEEP));
+            cJSON_AddItemToObject(j, "sah_over_float", json_arr(sw[i].sah, NSWEEP));
+        }
     }
-    putchar(']');
+    cbvh_json_print(root, stdout);
+    cJSON_Delete(root);
 }
 
 /* min / max / avg over scenes of one column (NaNs skipped). */
@@ -283,54 +328,84 @@ static void usage(FILE *f) {
             CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
 }
 
-int cmd_study(int argc, char **argv) {
-    const char *defaults[] = {CBVH_SCENES_DIR "/bunny-small.obj", "proc:cloth", "proc:far", "proc:wave"};
-    const char **specs = malloc((size_t)(argc + 4) * sizeof *specs);
-    int ns = 0, json = 0, sweep = 1;
-    cbvh_params p = {6, CBVH_MIN_SCALE_DEFAULT};
-    if (!specs) cbvh_out_of_memory("scene list");
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            usage(stdout);
-            free(specs);
-            return 0;
-        } else if (!strcmp(argv[i], "--json")) {
-            json = 1;
-        } else if (!strcmp(argv[i], "--no-sweep")) {
-            sweep = 0;
-        } else if (!strcmp(argv[i], "--quant-bits") || !strcmp(argv[i], "--min-scale")) {
-            /* One line naming the option and the value (not the usage). */
-            int q = argv[i][2] == 'q';
-            long lo = q ? CBVH_N_MIN : CBVH_SCALE_FLOOR, hi = q ? CBVH_N_MAX : CBVH_SCALE_CEIL, v;
-            if (i + 1 >= argc) {
-                fprintf(stderr, "cbvh study: %s needs a value (%ld..%ld)\n", argv[i], lo, hi);
-                free(specs);
-                return 2;
-            }
-            if (cbvh_parse_long(argv[i + 1], LONG_MIN, LONG_MAX, &v)) {
-                fprintf(stderr, "cbvh study: %s needs an integer in %ld..%ld, got '%s'\n", argv[i], lo, hi,
-                        argv[i + 1]);
-                free(specs);
-                return 2;
-            }
-            if (v < lo || v > hi) {
-                fprintf(stderr, "cbvh study: %s %s out of range %ld..%ld\n", argv[i], argv[i + 1], lo, hi);
-                free(specs);
-                return 2;
-            }
-            if (q)
-                p.quant_bits = (int)v;
-            else
-                p.min_scale = (int)v;
-            i++;
-        } else if (argv[i][0] == '-') {
-            fprintf(stderr, "cbvh study: unknown option '%s' (see cbvh study --help)\n", argv[i]);
-            free(specs);
-            return 2;
-        } else {
-            specs[ns++] = argv[i];
+typedef struct {
+    const char **specs; /* argc + 4 entries */
+    int ns, json, sweep;
+    cbvh_params p;
+} study_opts;
+
+/* --quant-bits / --min-scale: one line naming the option and the value (not
+ * the usage).  0 or -1. */
+static int parse_param(const char *opt, const char *val, long lo, long hi, int *out) {
+    long v;
+    if (!val) {
+        fprintf(stderr, "cbvh study: %s needs a value (%ld..%ld)\n", opt, lo, hi);
+        return -1;
+    }
+    if (cbvh_parse_long(val, LONG_MIN, LONG_MAX, &v)) {
+        fprintf(stderr, "cbvh study: %s needs an integer in %ld..%ld, got '%s'\n", opt, lo, hi, val);
+        return -1;
+    }
+    if (v < lo || v > hi) {
+        fprintf(stderr, "cbvh study: %s %s out of range %ld..%ld\n", opt, val, lo, hi);
+        return -1;
+    }
+    *out = (int)v;
+    return 0;
+}
+
+enum { OPT_JSON = 256, OPT_NO_SWEEP, OPT_QUANT_BITS, OPT_MIN_SCALE };
+
+/* --quant-bits or --min-scale (opt) with its value (NULL: missing). */
+static int set_param(int opt, const char *val, cbvh_params *p) {
+    return opt == OPT_QUANT_BITS ? parse_param("--quant-bits", val, CBVH_N_MIN, CBVH_N_MAX, &p->quant_bits)
+                                 : parse_param("--min-scale", val, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &p->min_scale);
+}
+
+/* 0: run; 1: --help printed; 2: bad input (one line printed). */
+static int parse_options(int argc, char **argv, study_opts *o) {
+    static const struct option lo[] = {{"help", no_argument, 0, 'h'},
+                                       {"json", no_argument, 0, OPT_JSON},
+                                       {"no-sweep", no_argument, 0, OPT_NO_SWEEP},
+                                       {"quant-bits", required_argument, 0, OPT_QUANT_BITS},
+                                       {"min-scale", required_argument, 0, OPT_MIN_SCALE},
+                                       {0, 0, 0, 0}};
+    int c;
+    optind = 0;
+    opterr = 0;
+    /* "-": scenes come back in order (as 1); ":": a missing value is ':' */
+    while ((c = getopt_long(argc, argv, "-:h", lo, NULL)) != -1) {
+        switch (c) {
+        case 1: o->specs[o->ns++] = optarg; break;
+        case 'h': usage(stdout); return 1;
+        case OPT_JSON: o->json = 1; break;
+        case OPT_NO_SWEEP: o->sweep = 0; break;
+        case OPT_QUANT_BITS:
+        case OPT_MIN_SCALE:
+            if (set_param(c, optarg, &o->p)) return 2;
+            break;
+        case ':': /* only the two options above take a value */
+            if (set_param(optopt, NULL, &o->p)) return 2;
+            break;
+        default: return cbvh_unknown_option("cbvh study", argv, optind);
         }
     }
+    while (optind < argc) o->specs[o->ns++] = argv[optind++]; /* after "--" */
+    return 0;
+}
+
+int cmd_study(int argc, char **argv) {
+    const char *defaults[] = {CBVH_SCENES_DIR "/bunny-small.obj", "proc:cloth", "proc:far", "proc:wave"};
+    study_opts o = {malloc((size_t)(argc + 4) * sizeof *o.specs), 0, 0, 1, {6, CBVH_MIN_SCALE_DEFAULT}};
+    if (!o.specs) cbvh_out_of_memory("scene list");
+    int rc = parse_options(argc, argv, &o);
+    if (rc) {
+        free(o.specs);
+        return rc == 1 ? 0 : 2;
+    }
+    const char **specs = o.specs;
+    int ns = o.ns, json = o.json, sweep = o.sweep;
+    cbvh_params p = o.p;
     if (ns == 0)
         for (int i = 0; i < 4; i++) specs[ns++] = defaults[i];
     scene_result *res = calloc((size_t)ns, sizeof *res);
@@ -347,46 +422,7 @@ int cmd_study(int argc, char **argv) {
         }
     }
     if (json) {
-        printf("{\"quant_bits\":%d,\"min_scale\":%d,\"configs\":[", p.quant_bits, p.min_scale);
-        for (int c = 0; c < NCFG; c++) printf("%s\"%s\"", c ? "," : "", cfg_name[c]);
-        printf("],\"traffic_model\":{\"input\":%d,\"sort\":%d,\"float_pair\":%d,\"id\":%d,\"backtrack\":%d},\"scenes\":[",
-               TR_INPUT, TR_SORT, TR_FLOAT_PAIR, TR_ID, TR_BACKTRACK);
-        for (int i = 0; i < ns; i++) {
-            const scene_result *r = &res[i];
-            printf("%s{\"name\":", i ? "," : "");
-            json_str(r->scene_name);
-            printf(",\"spec\":");
-            json_str(r->spec);
-            printf(",\"triangles\":%u,\"leaves\":%u,\"node_pairs\":%u,\"prims_per_leaf\":", r->tris, r->leaves,
-                   r->pairs);
-            json_num(r->prims_per_leaf);
-            printf(",\"sah_cbvh_over_float\":");
-            json_num(r->sah_ratio);
-            printf(",\"sah_cbvh_over_float_sah_builder\":");
-            json_num(r->sah_ratio_sah_builder);
-            printf(",\"cbvh_bytes\":%zu,\"float_bvh_bytes\":%zu,\"refit_deformation\":\"%s\",\"backtracks_lbvh\":[",
-                   r->cbvh_bytes, r->bvh_bytes, r->deform);
-            for (int c = 0; c < NCFG; c++) printf("%s%llu", c ? "," : "", (unsigned long long)r->bt_lbvh[c]);
-            printf("],\"backtracks_refit\":[");
-            for (int c = 0; c < NCFG; c++) printf("%s%llu", c ? "," : "", (unsigned long long)r->bt_refit[c]);
-            printf("],\"backtracks_norm\":");
-            json_arr(r->norm_bt, NCFG);
-            printf(",\"traffic_lbvh_norm\":");
-            json_arr(r->mem_lbvh, NCFG + 1);
-            printf(",\"traffic_refit_norm\":");
-            json_arr(r->mem_refit, NCFG + 1);
-            if (sweep) {
-                printf(",\"sweep\":{\"min_scale\":[");
-                for (int k = 0; k < NSWEEP; k++) printf("%s%d", k ? "," : "", sweep_scales[k]);
-                printf("],\"backtracks_per_prim\":");
-                json_arr(sw[i].bt_per_prim, NSWEEP);
-                printf(",\"sah_over_float\":");
-                json_arr(sw[i].sah, NSWEEP);
-                printf("}");
-            }
-            printf("}");
-        }
-        printf("]}\n");
+        json_write(res, sw, ns, sweep, p);
         goto done;
     }
     printf("cbvh study: N = %d, min scale 2^%d, LBVH (30-bit Morton, equal codes share a leaf)\n", p.quant_bits,

@@ -5,6 +5,7 @@
  * differing ray otherwise).  --formats cbvh,qbvh,tlist... adds the QBVH and
  * traversal lists as more rows, checked the same way. */
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -59,18 +60,28 @@ static void usage(FILE *f) {
             CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
 }
 
-static int is_int(const char *s) {
-    if (*s == '-' || *s == '+') s++;
-    if (!*s) return 0;
-    for (; *s; s++)
-        if (*s < '0' || *s > '9') return 0;
+
+/* The sign and digits of an integer, the whole of s[0..n). */
+static int is_int(const char *s, size_t n) {
+    size_t i = n && (s[0] == '-' || s[0] == '+');
+    if (i == n) return 0;
+    for (; i < n; i++)
+        if (s[i] < '0' || s[i] > '9') return 0;
     return 1;
 }
 
-/* An empty item in a comma list ("a,,b", ",a", "a,"), which strtok would skip. */
+/* An empty item in a comma list ("a,,b", ",a", "a,"). */
 static int has_empty_item(const char *s) {
     size_t n = strlen(s);
     return n == 0 || s[0] == ',' || s[n - 1] == ',' || strstr(s, ",,") != NULL;
+}
+
+/* "24" or "8,12,24": a value of a list option (else the next option or the scene). */
+static int is_int_list(const char *s) {
+    if (has_empty_item(s)) return 0;
+    for (const char *t = s; t; t = strchr(t, ',') ? strchr(t, ',') + 1 : NULL)
+        if (!is_int(t, strcspn(t, ","))) return 0;
+    return 1;
 }
 
 /* A list option given a second time: an error, not "the last wins" (that
@@ -83,43 +94,43 @@ static int list_again(const char *opt, int *given) {
     return 0;
 }
 
-/* Values after a list option: the following arguments that are integers
- * (comma-separated lists allowed).  Returns the count, -1 on error. */
-static int parse_list(const char *opt, int argc, char **argv, int *i, long lo, long hi, int *out, int max) {
-    int n = 0;
-    while (*i + 1 < argc) {
-        const char *a = argv[*i + 1];
-        char buf[256];
-        snprintf(buf, sizeof buf, "%s", a);
-        int all = !has_empty_item(a);
-        for (char *t = strtok(buf, ","); t; t = strtok(NULL, ","))
-            if (!is_int(t)) all = 0;
-        if (!all || !*a) break;
-        (*i)++;
-        snprintf(buf, sizeof buf, "%s", a);
-        for (char *t = strtok(buf, ","); t; t = strtok(NULL, ",")) {
-            long v;
-            if (cbvh_parse_long(t, lo, hi, &v)) {
-                fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%s'\n", opt, lo, hi, t);
-                return -1;
-            }
-            if (n == max) {
-                fprintf(stderr, "cbvh sweep: %s takes at most %d values\n", opt, max);
-                return -1;
-            }
-            for (int k = 0; k < n; k++)
-                if (out[k] == v) { /* the same setting twice would be traced and charted twice */
-                    fprintf(stderr, "cbvh sweep: %s: %ld given twice\n", opt, v);
-                    return -1;
-                }
-            out[n++] = (int)v;
+/* The items of one value of a list option (is_int_list) appended to out
+ * (n used of max): each in lo..hi and not given before.  0 or -1. */
+static int add_values(const char *opt, const char *a, long lo, long hi, int *out, int *n, int max) {
+    for (const char *t = a; t; t = strchr(t, ',') ? strchr(t, ',') + 1 : NULL) {
+        size_t len = strcspn(t, ",");
+        char item[32];
+        long v;
+        if (len >= sizeof item || (memcpy(item, t, len), item[len] = 0, cbvh_parse_long(item, lo, hi, &v))) {
+            fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%.*s'\n", opt, lo, hi, (int)len, t);
+            return -1;
         }
+        if (*n == max) {
+            fprintf(stderr, "cbvh sweep: %s takes at most %d values\n", opt, max);
+            return -1;
+        }
+        for (int k = 0; k < *n; k++)
+            if (out[k] == v) { /* the same setting twice would be traced and charted twice */
+                fprintf(stderr, "cbvh sweep: %s: %ld given twice\n", opt, v);
+                return -1;
+            }
+        out[(*n)++] = (int)v;
     }
-    if (!n) {
-        fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%s'\n", opt, lo, hi,
-                *i + 1 < argc ? argv[*i + 1] : "");
+    return 0;
+}
+
+/* A list option's values: first (getopt's optarg), then the following
+ * arguments that are integer lists too (optind moves past them).  Returns
+ * the count, -1 on error. */
+static int parse_list(const char *opt, const char *first, int argc, char **argv, long lo, long hi, int *out,
+                      int max) {
+    int n = 0;
+    if (!is_int_list(first)) {
+        fprintf(stderr, "cbvh sweep: %s expects integers in %ld..%ld, got '%s'\n", opt, lo, hi, first);
         return -1;
     }
+    for (const char *a = first; a; a = optind < argc && is_int_list(argv[optind]) ? argv[optind++] : NULL)
+        if (add_values(opt, a, lo, hi, out, &n, max)) return -1;
     return n;
 }
 
@@ -177,10 +188,6 @@ static int parse_heat(const char *s, heat_spec *h) {
     }
     return 0;
 }
-
-typedef struct {
-    int tty;
-} prog_ctx;
 
 static void progress(void *ctx, const char *label, int setting, int settings, int row, int rows) {
     (void)ctx;
@@ -312,178 +319,265 @@ static int check_writable(const char *dir) {
     return 0;
 }
 
-int cmd_sweep(int argc, char **argv) {
-    const char *scene = NULL, *outdir = NULL;
-    cbvh_sweep_opts o = {.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1};
-    int json = 0, nheat = 0, heat_given = 0, mant_given = 0, ms_given = 0, formats_given = 0;
-    long knee_pct = 10;
+
+/* ---- parse and validate: the command line --------------------------------- */
+
+/* The options as given (parse_options), completed with their defaults and
+ * checked against each other (validate_options). */
+typedef struct {
+    const char *scene, *outdir;
+    char outbuf[1024]; /* the default --out */
+    cbvh_sweep_opts run;
+    int json;
+    long knee_pct;
     heat_spec heat[MAX_HEAT];
-    const char *corrupt = NULL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--json") == 0)
-            json = 1;
-        else if (strcmp(a, "--bits") == 0) {
-            const char *v = i + 1 < argc ? argv[++i] : "";
-            char buf[64];
-            snprintf(buf, sizeof buf, "%s", v);
-            char *dd = strstr(buf, "..");
-            long lo, hi;
-            int bad;
-            if (dd) {
-                *dd = 0;
-                bad = cbvh_parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo) || cbvh_parse_long(dd + 2, CBVH_N_MIN, CBVH_N_MAX, &hi) ||
-                      lo > hi;
-            } else {
-                bad = cbvh_parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo);
-                hi = lo;
-            }
-            if (bad || strlen(v) >= sizeof buf) {
-                fprintf(stderr, "cbvh sweep: --bits expects LO..HI or N within %d..%d (LO <= HI), got '%s'\n",
-                        CBVH_N_MIN, CBVH_N_MAX, v);
-                return 2;
-            }
-            o.bits_lo = (int)lo;
-            o.bits_hi = (int)hi;
-        } else if (strcmp(a, "--mant") == 0) {
-            if (list_again(a, &mant_given)) return 2;
-            if ((o.nmant = parse_list(a, argc, argv, &i, CBVH_MANT_MIN, CBVH_MANT_MAX, o.mant, CBVH_SWEEP_MAX_LIST)) < 0)
-                return 2;
-        } else if (strcmp(a, "--min-scale") == 0) {
-            if (list_again(a, &ms_given)) return 2;
-            if ((o.nmin_scale = parse_list(a, argc, argv, &i, -126, 126, o.min_scale, CBVH_SWEEP_MAX_LIST)) < 0)
-                return 2;
-        } else if (strcmp(a, "--spp") == 0) {
-            long v;
-            if (cbvh_parse_long(i + 1 < argc ? argv[i + 1] : NULL, 1, 1024, &v)) {
-                fprintf(stderr, "cbvh sweep: --spp expects an integer in 1..1024, got '%s'\n",
-                        i + 1 < argc ? argv[i + 1] : "");
-                return 2;
-            }
-            i++;
-            o.spp = (int)v;
-        } else if (strcmp(a, "--knee") == 0) {
-            if (cbvh_parse_long(i + 1 < argc ? argv[i + 1] : NULL, 0, 1000, &knee_pct)) {
-                fprintf(stderr, "cbvh sweep: --knee expects a percentage in 0..1000, got '%s'\n",
-                        i + 1 < argc ? argv[i + 1] : "");
-                return 2;
-            }
-            i++;
-        } else if (strcmp(a, "--out") == 0) {
-            if (i + 1 >= argc || !argv[i + 1][0]) {
-                fprintf(stderr, "cbvh sweep: --out expects a directory\n");
-                return 2;
-            }
-            outdir = argv[++i];
-        } else if (strcmp(a, "--heatmap") == 0) {
-            if (list_again(a, &heat_given)) return 2;
-            int n0 = nheat;
-            while (i + 1 < argc && argv[i + 1][0] != '-' && (strcmp(argv[i + 1], "float") == 0 ||
-                                                              strcmp(argv[i + 1], "qbvh") == 0 ||
-                                                              strncmp(argv[i + 1], "tlist", 5) == 0 ||
-                                                              (argv[i + 1][0] >= '0' && argv[i + 1][0] <= '9'))) {
-                if (nheat == MAX_HEAT) {
-                    fprintf(stderr, "cbvh sweep: --heatmap takes at most %d settings\n", MAX_HEAT);
-                    return 2;
-                }
-                if (parse_heat(argv[i + 1], &heat[nheat])) {
-                    fprintf(stderr, "cbvh sweep: --heatmap expects float, N, N:M:E (N in %d..%d) or a format, got '%s'\n",
-                            CBVH_N_MIN, CBVH_N_MAX, argv[i + 1]);
-                    return 2;
-                }
-                nheat++;
-                i++;
-            }
-            if (nheat == n0) {
-                fprintf(stderr, "cbvh sweep: --heatmap expects float, N, N:M:E (N in %d..%d) or a format, got '%s'\n",
-                        CBVH_N_MIN, CBVH_N_MAX, i + 1 < argc ? argv[i + 1] : "");
-                return 2;
-            }
-        } else if (strcmp(a, "--one-sided") == 0)
-            o.one_sided = 1;
-        else if (strcmp(a, "--formats") == 0) {
-            if (list_again(a, &formats_given)) return 2;
-            const char *v = i + 1 < argc ? argv[++i] : "";
-            char buf[512], ferr[200] = "";
-            size_t len = strlen(v);
-            int cb = 0, bad = len >= sizeof buf || has_empty_item(v);
-            if (!bad) memcpy(buf, v, len + 1);
-            o.nextra = 0;
-            for (char *t = strtok(buf, ","); t && !bad; t = strtok(NULL, ",")) {
-                if (strcmp(t, "cbvh") == 0) {
-                    cb = 1;
-                    continue;
-                }
-                cbvh_sweep_format f;
-                if (strcmp(t, "qbvh") != 0 && strncmp(t, "tlist", 5) != 0)
-                    bad = 1;
-                else if (parse_format(t, &f, ferr, sizeof ferr))
-                    bad = 2;
-                else if (o.nextra == CBVH_SWEEP_MAX_EXTRA) {
-                    snprintf(ferr, sizeof ferr, "at most %d formats besides cbvh", CBVH_SWEEP_MAX_EXTRA);
-                    bad = 2;
-                } else {
-                    for (int k = 0; k < o.nextra; k++)
-                        if (strcmp(o.extra[k].name, f.name) == 0) {
-                            snprintf(ferr, sizeof ferr, "format %s given twice", f.name);
-                            bad = 2;
-                        }
-                    if (!bad) o.extra[o.nextra++] = f;
-                }
-            }
-            if (bad == 2) {
-                fprintf(stderr, "cbvh sweep: --formats: %s\n", ferr);
-                return 2;
-            }
-            if (bad || !cb) {
-                fprintf(stderr, "cbvh sweep: --formats expects cbvh[,qbvh][,tlist[:options]...], got '%s'\n", v);
-                return 2;
-            }
-        } else if (strcmp(a, "--test-corrupt") == 0) {
-            /* Test hook (docs/sweep.md): SETTING_INDEX:RAY_INDEX. */
-            corrupt = i + 1 < argc ? argv[++i] : "";
-            long si, ri;
-            char buf[64];
-            snprintf(buf, sizeof buf, "%s", corrupt);
-            char *c = strchr(buf, ':');
-            if (!c || (*c = 0, cbvh_parse_long(buf, 0, 100000, &si)) || cbvh_parse_long(c + 1, 0, 2000000000L, &ri)) {
-                fprintf(stderr, "cbvh sweep: --test-corrupt expects SETTING:RAY, got '%s'\n", corrupt);
-                return 2;
-            }
-            o.corrupt_setting = (int)si;
-            o.corrupt_ray = (uint64_t)ri;
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "cbvh sweep: unknown option '%s' (see cbvh sweep --help)\n", a);
-            return 2;
-        } else if (scene) {
-            fprintf(stderr, "cbvh sweep: more than one scene ('%s', '%s')\n", scene, a);
-            return 2;
-        } else
-            scene = a;
+    int nheat;
+    int mant_given, ms_given, heat_given, formats_given; /* list options: once each */
+} sweep_cli;
+
+enum {
+    OPT_JSON = 256,
+    OPT_BITS,
+    OPT_MANT,
+    OPT_MIN_SCALE,
+    OPT_SPP,
+    OPT_KNEE,
+    OPT_OUT,
+    OPT_HEATMAP,
+    OPT_ONE_SIDED,
+    OPT_FORMATS,
+    OPT_TEST_CORRUPT
+};
+
+static int parse_bits(const char *v, cbvh_sweep_opts *o) {
+    char buf[64];
+    snprintf(buf, sizeof buf, "%s", v);
+    char *dd = strstr(buf, "..");
+    long lo, hi;
+    int bad;
+    if (dd) {
+        *dd = 0;
+        bad = cbvh_parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo) || cbvh_parse_long(dd + 2, CBVH_N_MIN, CBVH_N_MAX, &hi) ||
+              lo > hi;
+    } else {
+        bad = cbvh_parse_long(buf, CBVH_N_MIN, CBVH_N_MAX, &lo);
+        hi = lo;
     }
-    if (!scene) {
+    if (bad || strlen(v) >= sizeof buf) {
+        fprintf(stderr, "cbvh sweep: --bits expects LO..HI or N within %d..%d (LO <= HI), got '%s'\n", CBVH_N_MIN,
+                CBVH_N_MAX, v);
+        return -1;
+    }
+    o->bits_lo = (int)lo;
+    o->bits_hi = (int)hi;
+    return 0;
+}
+
+/* A word --heatmap takes (else the next option or the scene). */
+static int is_heat_word(const char *a) {
+    return a[0] != '-' && (strcmp(a, "float") == 0 || strcmp(a, "qbvh") == 0 || strncmp(a, "tlist", 5) == 0 ||
+                           (a[0] >= '0' && a[0] <= '9'));
+}
+
+/* --heatmap's settings: first, then the following heat words. */
+static int parse_heatmaps(const char *first, int argc, char **argv, sweep_cli *c) {
+    const char *a = is_heat_word(first) ? first : NULL;
+    if (!a) {
+        fprintf(stderr, "cbvh sweep: --heatmap expects float, N, N:M:E (N in %d..%d) or a format, got '%s'\n",
+                CBVH_N_MIN, CBVH_N_MAX, first);
+        return -1;
+    }
+    for (; a; a = optind < argc && is_heat_word(argv[optind]) ? argv[optind++] : NULL) {
+        if (c->nheat == MAX_HEAT) {
+            fprintf(stderr, "cbvh sweep: --heatmap takes at most %d settings\n", MAX_HEAT);
+            return -1;
+        }
+        if (parse_heat(a, &c->heat[c->nheat])) {
+            fprintf(stderr, "cbvh sweep: --heatmap expects float, N, N:M:E (N in %d..%d) or a format, got '%s'\n",
+                    CBVH_N_MIN, CBVH_N_MAX, a);
+            return -1;
+        }
+        c->nheat++;
+    }
+    return 0;
+}
+
+static int parse_formats(const char *v, cbvh_sweep_opts *o) {
+    char buf[512], ferr[200] = "";
+    size_t len = strlen(v);
+    int cb = 0, bad = len >= sizeof buf || has_empty_item(v);
+    if (!bad) memcpy(buf, v, len + 1);
+    o->nextra = 0;
+    for (char *t = bad ? NULL : strtok(buf, ","); t && !bad; t = strtok(NULL, ",")) {
+        if (strcmp(t, "cbvh") == 0) {
+            cb = 1;
+            continue;
+        }
+        cbvh_sweep_format f;
+        if (strcmp(t, "qbvh") != 0 && strncmp(t, "tlist", 5) != 0)
+            bad = 1;
+        else if (parse_format(t, &f, ferr, sizeof ferr))
+            bad = 2;
+        else if (o->nextra == CBVH_SWEEP_MAX_EXTRA) {
+            snprintf(ferr, sizeof ferr, "at most %d formats besides cbvh", CBVH_SWEEP_MAX_EXTRA);
+            bad = 2;
+        } else {
+            for (int k = 0; k < o->nextra; k++)
+                if (strcmp(o->extra[k].name, f.name) == 0) {
+                    snprintf(ferr, sizeof ferr, "format %s given twice", f.name);
+                    bad = 2;
+                }
+            if (!bad) o->extra[o->nextra++] = f;
+        }
+    }
+    if (bad == 2) {
+        fprintf(stderr, "cbvh sweep: --formats: %s\n", ferr);
+        return -1;
+    }
+    if (bad || !cb) {
+        fprintf(stderr, "cbvh sweep: --formats expects cbvh[,qbvh][,tlist[:options]...], got '%s'\n", v);
+        return -1;
+    }
+    return 0;
+}
+
+/* Test hook (docs/sweep.md): SETTING_INDEX:RAY_INDEX. */
+static int parse_corrupt(const char *v, cbvh_sweep_opts *o) {
+    long si, ri;
+    char buf[64];
+    snprintf(buf, sizeof buf, "%s", v);
+    char *c = strchr(buf, ':');
+    if (!c || (*c = 0, cbvh_parse_long(buf, 0, 100000, &si)) || cbvh_parse_long(c + 1, 0, 2000000000L, &ri)) {
+        fprintf(stderr, "cbvh sweep: --test-corrupt expects SETTING:RAY, got '%s'\n", v);
+        return -1;
+    }
+    o->corrupt_setting = (int)si;
+    o->corrupt_ray = (uint64_t)ri;
+    return 0;
+}
+
+static int set_scene(sweep_cli *c, const char *a) {
+    if (c->scene) {
+        fprintf(stderr, "cbvh sweep: more than one scene ('%s', '%s')\n", c->scene, a);
+        return -1;
+    }
+    c->scene = a;
+    return 0;
+}
+
+/* One option and its value ("" when missing: each option's own message). */
+static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli *c) {
+    cbvh_sweep_opts *o = &c->run;
+    long n;
+    switch (opt) {
+    case OPT_JSON: c->json = 1; return 0;
+    case OPT_ONE_SIDED: o->one_sided = 1; return 0;
+    case OPT_BITS: return parse_bits(v, o);
+    case OPT_MANT:
+        if (list_again("--mant", &c->mant_given)) return -1;
+        o->nmant = parse_list("--mant", v, argc, argv, CBVH_MANT_MIN, CBVH_MANT_MAX, o->mant, CBVH_SWEEP_MAX_LIST);
+        return o->nmant < 0 ? -1 : 0;
+    case OPT_MIN_SCALE:
+        if (list_again("--min-scale", &c->ms_given)) return -1;
+        o->nmin_scale = parse_list("--min-scale", v, argc, argv, -126, 126, o->min_scale, CBVH_SWEEP_MAX_LIST);
+        return o->nmin_scale < 0 ? -1 : 0;
+    case OPT_SPP:
+        if (cbvh_parse_long(v, 1, 1024, &n)) {
+            fprintf(stderr, "cbvh sweep: --spp expects an integer in 1..1024, got '%s'\n", v);
+            return -1;
+        }
+        o->spp = (int)n;
+        return 0;
+    case OPT_KNEE:
+        if (cbvh_parse_long(v, 0, 1000, &c->knee_pct)) {
+            fprintf(stderr, "cbvh sweep: --knee expects a percentage in 0..1000, got '%s'\n", v);
+            return -1;
+        }
+        return 0;
+    case OPT_OUT:
+        if (!v[0]) {
+            fprintf(stderr, "cbvh sweep: --out expects a directory\n");
+            return -1;
+        }
+        c->outdir = v;
+        return 0;
+    case OPT_HEATMAP:
+        if (list_again("--heatmap", &c->heat_given)) return -1;
+        return parse_heatmaps(v, argc, argv, c);
+    case OPT_FORMATS:
+        if (list_again("--formats", &c->formats_given)) return -1;
+        return parse_formats(v, o);
+    default: /* OPT_TEST_CORRUPT */
+        return parse_corrupt(v, o);
+    }
+}
+
+/* 0: run; 1: --help printed; 2: bad input (one line printed). */
+static int parse_options(int argc, char **argv, sweep_cli *c) {
+    static const struct option lo[] = {{"help", no_argument, 0, 'h'},
+                                       {"json", no_argument, 0, OPT_JSON},
+                                       {"bits", required_argument, 0, OPT_BITS},
+                                       {"mant", required_argument, 0, OPT_MANT},
+                                       {"min-scale", required_argument, 0, OPT_MIN_SCALE},
+                                       {"spp", required_argument, 0, OPT_SPP},
+                                       {"knee", required_argument, 0, OPT_KNEE},
+                                       {"out", required_argument, 0, OPT_OUT},
+                                       {"heatmap", required_argument, 0, OPT_HEATMAP},
+                                       {"one-sided", no_argument, 0, OPT_ONE_SIDED},
+                                       {"formats", required_argument, 0, OPT_FORMATS},
+                                       {"test-corrupt", required_argument, 0, OPT_TEST_CORRUPT},
+                                       {0, 0, 0, 0}};
+    memset(c, 0, sizeof *c);
+    c->run = (cbvh_sweep_opts){.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1};
+    c->knee_pct = 10;
+    int opt;
+    optind = 0;
+    opterr = 0;
+    /* "-": the scene comes back in order (as 1), so that a list option can
+     * take the arguments after its first value; ":": a missing value is ':' */
+    while ((opt = getopt_long(argc, argv, "-:h", lo, NULL)) != -1) {
+        int bad;
+        if (opt == 'h') {
+            usage(stdout);
+            return 1;
+        } else if (opt == 1)
+            bad = set_scene(c, optarg);
+        else if (opt == ':')
+            bad = parse_option(optopt, "", argc, argv, c);
+        else if (opt >= OPT_JSON)
+            bad = parse_option(opt, optarg, argc, argv, c);
+        else
+            return cbvh_unknown_option("cbvh sweep", argv, optind);
+        if (bad) return 2;
+    }
+    for (; optind < argc; optind++) /* after "--" */
+        if (set_scene(c, argv[optind])) return 2;
+    return 0;
+}
+
+/* Defaults, and the heat maps against what the sweep traces.  0 or 2. */
+static int validate_options(sweep_cli *c) {
+    cbvh_sweep_opts *o = &c->run;
+    if (!c->scene) {
         fprintf(stderr, "cbvh sweep: no scene file given (see cbvh sweep --help)\n");
         return 2;
     }
-    if (!o.nmant) o.mant[o.nmant++] = CBVH_MANT_MAX;
-    if (!o.nmin_scale) o.min_scale[o.nmin_scale++] = CBVH_MIN_SCALE_DEFAULT;
-    if (!heat_given) {
-        heat[nheat++] = (heat_spec){.is_float = 1};
+    if (!o->nmant) o->mant[o->nmant++] = CBVH_MANT_MAX;
+    if (!o->nmin_scale) o->min_scale[o->nmin_scale++] = CBVH_MIN_SCALE_DEFAULT;
+    if (!c->heat_given) {
+        c->heat[c->nheat++] = (heat_spec){.is_float = 1};
         static const int def[] = {3, 6, 10};
         for (int k = 0; k < 3; k++)
-            if (def[k] >= o.bits_lo && def[k] <= o.bits_hi) heat[nheat++] = (heat_spec){.bits = def[k]};
-        for (int k = 0; k < o.nextra && nheat < MAX_HEAT; k++) heat[nheat++] = (heat_spec){.xf = k + 1};
+            if (def[k] >= o->bits_lo && def[k] <= o->bits_hi) c->heat[c->nheat++] = (heat_spec){.bits = def[k]};
+        for (int k = 0; k < o->nextra && c->nheat < MAX_HEAT; k++) c->heat[c->nheat++] = (heat_spec){.xf = k + 1};
     }
     /* Every heat-map setting must be one the sweep traces. */
-    for (int h = 0; h < nheat; h++) {
-        heat_spec *s = &heat[h];
+    for (int h = 0; h < c->nheat; h++) {
+        heat_spec *s = &c->heat[h];
         if (s->is_float || s->xf) continue;
         if (s->fmt[0]) {
-            for (int k = 0; k < o.nextra; k++)
-                if (strcmp(o.extra[k].name, s->fmt) == 0) s->xf = k + 1;
+            for (int k = 0; k < o->nextra; k++)
+                if (strcmp(o->extra[k].name, s->fmt) == 0) s->xf = k + 1;
             if (!s->xf) {
                 fprintf(stderr, "cbvh sweep: --heatmap %s needs --formats cbvh,%s\n", s->fmt, s->fmt);
                 return 2;
@@ -491,22 +585,22 @@ int cmd_sweep(int argc, char **argv) {
             continue;
         }
         if (!s->explicit_all) {
-            s->mant = o.mant[0];
-            s->min_scale = o.min_scale[0];
+            s->mant = o->mant[0];
+            s->min_scale = o->min_scale[0];
         }
         int inm = 0, ine = 0;
-        for (int k = 0; k < o.nmant; k++) inm |= o.mant[k] == s->mant;
-        for (int k = 0; k < o.nmin_scale; k++) ine |= o.min_scale[k] == s->min_scale;
-        if (s->bits < o.bits_lo || s->bits > o.bits_hi || !inm || !ine) {
+        for (int k = 0; k < o->nmant; k++) inm |= o->mant[k] == s->mant;
+        for (int k = 0; k < o->nmin_scale; k++) ine |= o->min_scale[k] == s->min_scale;
+        if (s->bits < o->bits_lo || s->bits > o->bits_hi || !inm || !ine) {
             fprintf(stderr, "cbvh sweep: --heatmap %d:%d:%d is not a setting of this sweep\n", s->bits, s->mant,
                     s->min_scale);
             return 2;
         }
     }
     /* The same map twice (also "6" and "6:24:-30") would be drawn twice. */
-    for (int h = 0; h < nheat; h++)
+    for (int h = 0; h < c->nheat; h++)
         for (int g = 0; g < h; g++) {
-            const heat_spec *s = &heat[h], *t = &heat[g];
+            const heat_spec *s = &c->heat[h], *t = &c->heat[g];
             if (s->is_float != t->is_float || s->xf != t->xf ||
                 (!s->is_float && !s->xf &&
                  (s->bits != t->bits || s->mant != t->mant || s->min_scale != t->min_scale)))
@@ -514,342 +608,412 @@ int cmd_sweep(int argc, char **argv) {
             if (s->is_float)
                 fprintf(stderr, "cbvh sweep: --heatmap: float given twice\n");
             else if (s->xf)
-                fprintf(stderr, "cbvh sweep: --heatmap: %s given twice\n", o.extra[s->xf - 1].name);
+                fprintf(stderr, "cbvh sweep: --heatmap: %s given twice\n", o->extra[s->xf - 1].name);
             else
                 fprintf(stderr, "cbvh sweep: --heatmap: setting %d:%d:%d given twice\n", s->bits, s->mant,
                         s->min_scale);
             return 2;
         }
-    char outbuf[1024];
-    if (!outdir) {
-        default_out(scene, outbuf, sizeof outbuf);
-        outdir = outbuf;
+    if (!c->outdir) {
+        default_out(c->scene, c->outbuf, sizeof c->outbuf);
+        c->outdir = c->outbuf;
     }
-    cbvh_scene_desc d;
-    char err[1024];
-    if (cbvh_scene_file_open(scene, &d, err, sizeof err)) {
-        fprintf(stderr, "cbvh sweep: %s\n", err);
+    return 0;
+}
+
+/* The number of settings the sweep traces: N x M x E, then the other formats. */
+static int settings_count(const cbvh_sweep_opts *o) {
+    return (o->bits_hi - o->bits_lo + 1) * o->nmant * o->nmin_scale + o->nextra;
+}
+
+/* The checks that need the scene (the test hook's setting) and --out, before
+ * anything is traced.  0 or 2. */
+static int validate_run(const sweep_cli *c) {
+    if (c->run.corrupt_setting >= settings_count(&c->run)) {
+        fprintf(stderr, "cbvh sweep: --test-corrupt setting %d: the sweep has %d settings\n", c->run.corrupt_setting,
+                settings_count(&c->run));
         return 2;
     }
-    int nb = o.bits_hi - o.bits_lo + 1;
-    if (o.corrupt_setting >= nb * o.nmant * o.nmin_scale + o.nextra) {
-        fprintf(stderr, "cbvh sweep: --test-corrupt setting %d: the sweep has %d settings\n", o.corrupt_setting,
-                nb * o.nmant * o.nmin_scale + o.nextra);
-        cbvh_scene_desc_free(&d);
-        return 2;
-    }
-    if (ensure_dir(outdir) || check_writable(outdir)) {
-        cbvh_scene_desc_free(&d);
-        return 2;
-    }
+    return ensure_dir(c->outdir) || check_writable(c->outdir) ? 2 : 0;
+}
+
+/* ---- compute: the sweep and the figures derived from it ------------------- */
+
+typedef struct {
+    cbvh_timing_params tp;
+    cbvh_sweep_result res;
+    cbvh_fx_stats ftot; /* the float BVH's totals over effects */
+    int nb, ncombo;     /* values of N; combinations M x E */
+    int *bits;          /* the nb values of N */
+    double *relv;       /* [metric * nrows + row]: total cost relative to the float BVH */
+    double tol;         /* the knee tolerance, a fraction */
+    /* knee[c][m] for the four modelled metrics (CPU time is noisy: not a knee) */
+    int knee[CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];
+} sweep_figures;
+
+/* 0, or 2 with one line printed: the run could not be done (not a finding
+ * about hits). */
+static int compute(const sweep_cli *c, const cbvh_scene_desc *d, sweep_figures *f) {
+    memset(f, 0, sizeof *f);
+    cbvh_sweep_opts o = c->run;
     int tty = isatty(2);
     if (tty) o.progress = progress;
-    cbvh_timing_params tp;
-    cbvh_fx_timing(&d, &tp);
-    cbvh_sweep_result res;
-    if (cbvh_sweep_run(&d, &o, &res, err, sizeof err)) {
+    cbvh_fx_timing(d, &f->tp);
+    char err[1024];
+    if (cbvh_sweep_run(d, &o, &f->res, err, sizeof err)) {
         if (tty) fprintf(stderr, "\n");
-        fprintf(stderr, "cbvh sweep: %s: %s\n", scene, err);
-        cbvh_scene_desc_free(&d);
-        return 2; /* the run could not be done: not a finding about hits */
+        fprintf(stderr, "cbvh sweep: %s: %s\n", c->scene, err);
+        return 2;
     }
     if (tty) fprintf(stderr, "\r%70s\r", "");
 
     /* Relative totals per setting, for the knee and the chart. */
-    double tol = (double)knee_pct / 100.0;
-    int ncombo = o.nmant * o.nmin_scale;
-    cbvh_fx_stats ftot = cbvh_fx_total(&res.ref.r);
+    const cbvh_sweep_result *res = &f->res;
+    f->tol = (double)c->knee_pct / 100.0;
+    f->nb = o.bits_hi - o.bits_lo + 1;
+    f->ncombo = o.nmant * o.nmin_scale;
+    f->ftot = cbvh_fx_total(&res->ref.r);
     double fq[SWEEP_NMETRICS];
-    cbvh_sweep_per_ray(&ftot, &tp, fq);
-    double *relv = calloc((size_t)res.nrows * SWEEP_NMETRICS, sizeof *relv);
-    int *bits = calloc((size_t)nb, sizeof *bits);
-    if (!relv || !bits) cbvh_out_of_memory("sweep chart data");
-    for (int b = 0; b < nb; b++) bits[b] = o.bits_lo + b;
-    for (int i = 0; i < res.nrows; i++) {
-        cbvh_fx_stats t = cbvh_fx_total(&res.rows[i].r);
+    cbvh_sweep_per_ray(&f->ftot, &f->tp, fq);
+    f->relv = calloc((size_t)res->nrows * SWEEP_NMETRICS, sizeof *f->relv);
+    f->bits = calloc((size_t)f->nb, sizeof *f->bits);
+    if (!f->relv || !f->bits) cbvh_out_of_memory("sweep chart data");
+    for (int b = 0; b < f->nb; b++) f->bits[b] = o.bits_lo + b;
+    for (int i = 0; i < res->nrows; i++) {
+        cbvh_fx_stats t = cbvh_fx_total(&res->rows[i].r);
         double p[SWEEP_NMETRICS];
-        cbvh_sweep_per_ray(&t, &tp, p);
-        for (int m = 0; m < SWEEP_NMETRICS; m++) relv[(size_t)m * res.nrows + i] = cbvh_ratio(p[m], fq[m]);
+        cbvh_sweep_per_ray(&t, &f->tp, p);
+        for (int m = 0; m < SWEEP_NMETRICS; m++) f->relv[(size_t)m * res->nrows + i] = cbvh_ratio(p[m], fq[m]);
     }
-    /* knee[c][m] for the four modelled metrics (CPU time is noisy: not a knee). */
-    int knee[CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];
-    for (int c = 0; c < ncombo; c++)
-        for (int m = 0; m < 4; m++) knee[c][m] = cbvh_sweep_knee(bits, &relv[(size_t)m * res.nrows + c * nb], nb, tol);
+    for (int k = 0; k < f->ncombo; k++)
+        for (int m = 0; m < 4; m++)
+            f->knee[k][m] = cbvh_sweep_knee(f->bits, &f->relv[(size_t)m * res->nrows + k * f->nb], f->nb, f->tol);
+    return 0;
+}
 
-    /* Outputs: chart(s) and heat maps. */
-    int status = res.all_same ? 0 : 1;
-    char path[2048], title[1400];
+static void free_figures(sweep_figures *f) {
+    free(f->bits);
+    free(f->relv);
+    cbvh_sweep_free(&f->res);
+}
+
+/* ---- write: chart, heat maps, image; then the table or the JSON ----------- */
+
+/* The files written to --out, and the first one that could not be. */
+typedef struct {
     char written[16][2100];
-    int nwritten = 0, nfailed = 0;
-    char failed[1100] = ""; /* the first output file not written: one line at the end */
-    double *x = calloc((size_t)nb, sizeof *x);
+    int nwritten, nfailed;
+    char failed[1100];
+    double heat_max; /* the heat maps' common colour scale: 0 .. heat_max box tests */
+} sweep_files;
+
+static void file_done(sweep_files *w, const char *path, int failed, const char *err) {
+    if (failed) {
+        if (!w->nfailed++) snprintf(w->failed, sizeof w->failed, "%s", err);
+    } else if (w->nwritten < 16)
+        snprintf(w->written[w->nwritten++], sizeof w->written[0], "%s", path);
+}
+
+static void write_files(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, sweep_files *w) {
+    const cbvh_sweep_result *res = &f->res;
+    const char *outdir = c->outdir;
+    char path[2048], title[1400], err[1024];
+    memset(w, 0, sizeof *w);
+    double *x = calloc((size_t)f->nb, sizeof *x);
     if (!x) cbvh_out_of_memory("sweep chart axis");
-    for (int b = 0; b < nb; b++) x[b] = bits[b];
-    for (int c = 0; c < ncombo && nwritten < 8; c++) {
-        const cbvh_sweep_setting *s = &res.rows[c * nb].s;
-        if (ncombo == 1)
+    for (int b = 0; b < f->nb; b++) x[b] = f->bits[b];
+    for (int k = 0; k < f->ncombo && w->nwritten < 8; k++) {
+        const cbvh_sweep_setting *s = &res->rows[k * f->nb].s;
+        if (f->ncombo == 1)
             snprintf(path, sizeof path, "%s/cost.svg", outdir);
         else
             snprintf(path, sizeof path, "%s/cost-M%d-E%d.svg", outdir, s->mant, s->min_scale);
-        const char *mesh = strrchr(d.mesh_spec, '/');
+        const char *mesh = strrchr(d->mesh_spec, '/');
         snprintf(title, sizeof title, "%s: cost relative to the float BVH (M=%d, min scale %d)",
-                 mesh ? mesh + 1 : d.mesh_spec, s->mant, s->min_scale);
+                 mesh ? mesh + 1 : d->mesh_spec, s->mant, s->min_scale);
         /* Only the costs with a ratio (knee 0: the float BVH did none of it). */
         cbvh_svg_series ser[4];
         int nser = 0;
         for (int m = 0; m < 4; m++)
-            if (knee[c][m]) ser[nser++] = (cbvh_svg_series){metric_names[m], &relv[(size_t)m * res.nrows + c * nb]};
+            if (f->knee[k][m])
+                ser[nser++] = (cbvh_svg_series){metric_names[m], &f->relv[(size_t)m * res->nrows + k * f->nb]};
         if (!nser) continue;
-        if (cbvh_svg_chart(path, title, "coordinate bits N", "cost / float BVH", x, (size_t)nb, ser, (size_t)nser,
-                           err, sizeof err)) {
-            if (!nfailed++) snprintf(failed, sizeof failed, "%s", err);
-        } else
-            snprintf(written[nwritten++], sizeof written[0], "%s", path);
+        int bad = cbvh_svg_chart(path, title, "coordinate bits N", "cost / float BVH", x, (size_t)f->nb, ser,
+                                 (size_t)nser, err, sizeof err);
+        file_done(w, path, bad, err);
     }
+    free(x);
     /* Heat maps on one colour scale: 0 .. the largest pixel of any chosen setting. */
     const cbvh_sweep_run_t *hr[MAX_HEAT];
     double vmax = 0;
-    size_t npx = (size_t)res.width * (size_t)res.height;
-    for (int h = 0; h < nheat; h++) {
-        hr[h] = heat[h].xf ? &res.extra[heat[h].xf - 1] : &res.ref;
-        if (!heat[h].is_float && !heat[h].xf)
-            for (int i = 0; i < res.nrows; i++)
-                if (res.rows[i].s.bits == heat[h].bits && res.rows[i].s.mant == heat[h].mant &&
-                    res.rows[i].s.min_scale == heat[h].min_scale)
-                    hr[h] = &res.rows[i];
+    size_t npx = (size_t)res->width * (size_t)res->height;
+    for (int h = 0; h < c->nheat; h++) {
+        const heat_spec *hs = &c->heat[h];
+        hr[h] = hs->xf ? &res->extra[hs->xf - 1] : &res->ref;
+        if (!hs->is_float && !hs->xf)
+            for (int i = 0; i < res->nrows; i++)
+                if (res->rows[i].s.bits == hs->bits && res->rows[i].s.mant == hs->mant &&
+                    res->rows[i].s.min_scale == hs->min_scale)
+                    hr[h] = &res->rows[i];
         for (size_t p = 0; p < npx; p++)
             if (hr[h]->box_px[p] > vmax) vmax = hr[h]->box_px[p];
     }
     if (!(vmax > 0)) vmax = 1;
-    double used_min = 0, used_max = vmax;
-    for (int h = 0; h < nheat; h++) {
-        if (heat[h].is_float)
+    double used_min = 0;
+    w->heat_max = vmax;
+    for (int h = 0; h < c->nheat; h++) {
+        const heat_spec *hs = &c->heat[h];
+        if (hs->is_float)
             snprintf(path, sizeof path, "%s/heat-float.png", outdir);
-        else if (heat[h].xf) {
+        else if (hs->xf) {
             char fn[48];
-            snprintf(fn, sizeof fn, "%s", o.extra[heat[h].xf - 1].name);
+            snprintf(fn, sizeof fn, "%s", c->run.extra[hs->xf - 1].name);
             for (char *p = fn; *p; p++)
                 if (*p == ':') *p = '-';
             snprintf(path, sizeof path, "%s/heat-%s.png", outdir, fn);
-        }
-        else if (heat[h].explicit_all)
-            snprintf(path, sizeof path, "%s/heat-N%d-M%d-E%d.png", outdir, heat[h].bits, heat[h].mant,
-                     heat[h].min_scale);
+        } else if (hs->explicit_all)
+            snprintf(path, sizeof path, "%s/heat-N%d-M%d-E%d.png", outdir, hs->bits, hs->mant, hs->min_scale);
         else
-            snprintf(path, sizeof path, "%s/heat-N%d.png", outdir, heat[h].bits);
-        if (cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res.width, (unsigned)res.height, 0, vmax, 0, &used_min,
-                             &used_max, err, sizeof err)) {
-            if (!nfailed++) snprintf(failed, sizeof failed, "%s", err);
-        } else if (nwritten < 16)
-            snprintf(written[nwritten++], sizeof written[0], "%s", path);
+            snprintf(path, sizeof path, "%s/heat-N%d.png", outdir, hs->bits);
+        int bad = cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res->width, (unsigned)res->height, 0, vmax, 0,
+                                   &used_min, &w->heat_max, err, sizeof err);
+        file_done(w, path, bad, err);
     }
     snprintf(path, sizeof path, "%s/render-float.png", outdir);
-    if (cbvh_png_write(path, res.ref.image, (unsigned)res.width, (unsigned)res.height, 1, err, sizeof err)) {
-        if (!nfailed++) snprintf(failed, sizeof failed, "%s", err);
-    } else if (nwritten < 16)
-        snprintf(written[nwritten++], sizeof written[0], "%s", path);
+    int bad = cbvh_png_write(path, res->ref.image, (unsigned)res->width, (unsigned)res->height, 1, err, sizeof err);
+    file_done(w, path, bad, err);
+}
 
-    int first_bad = -1;
-    for (int i = 0; i < res.nrows; i++)
-        if (!res.rows[i].same) {
-            first_bad = i;
-            break;
-        }
-    for (int k = 0; first_bad < 0 && k < res.nextra; k++)
-        if (!res.extra[k].same) first_bad = res.nrows + k;
+/* The "effects" and "total" of one traced configuration against the float BVH's. */
+static void json_effects(cJSON *o, const cbvh_scene_desc *d, const sweep_figures *f, const cbvh_sweep_run_t *r) {
+    const cbvh_sweep_run_t *ref = &f->res.ref;
+    cJSON *ef = cJSON_AddObjectToObject(o, "effects");
+    for (int e = 0; e < CBVH_FX_COUNT; e++)
+        if (d->effect[e].enabled)
+            cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
+                                  json_costs(&r->r.fx[e], &ref->r.fx[e], r->r.node_bytes, ref->r.node_bytes, &f->tp));
+    cbvh_fx_stats t = cbvh_fx_total(&r->r);
+    cJSON_AddItemToObject(o, "total", json_costs(&t, &f->ftot, r->r.node_bytes, ref->r.node_bytes, &f->tp));
+}
+
+static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, const sweep_files *w) {
     static const char *knee_keys[4] = {"box_tests", "tri_tests", "bytes", "model_time"};
-    if (nfailed) status = status ? status : 2; /* an output file not written */
-    /* A file not written: no JSON (its "files" would pass for a complete run),
-     * only the error line below, as trace and run print no JSON on an error. */
-    if (json && !nfailed) {
-        cJSON *root = cJSON_CreateObject();
-        cJSON_AddStringToObject(root, "scene", scene);
-        cJSON_AddStringToObject(root, "mesh", d.mesh_spec);
-        cJSON_AddNumberToObject(root, "triangles", d.mesh.ntris);
-        cJSON_AddNumberToObject(root, "width", res.width);
-        cJSON_AddNumberToObject(root, "height", res.height);
-        cJSON_AddNumberToObject(root, "spp", res.spp);
-        cJSON_AddNumberToObject(root, "frames", res.frames);
-        cJSON_AddNumberToObject(root, "rays", (double)res.ref_rays);
-        cJSON *tj = cJSON_AddObjectToObject(root, "timing");
-        cJSON_AddNumberToObject(tj, "box_cycles", tp.box_cycles);
-        cJSON_AddNumberToObject(tj, "tri_cycles", tp.tri_cycles);
-        cJSON_AddNumberToObject(tj, "fetch_latency", tp.fetch_latency);
-        cJSON_AddNumberToObject(tj, "dram_bytes_per_cycle", tp.dram_bytes_per_cycle);
-        cJSON_AddNumberToObject(tj, "clock_mhz", tp.clock_mhz);
-        cJSON *fl = cJSON_AddObjectToObject(root, "float");
-        cJSON_AddNumberToObject(fl, "node_bytes", (double)res.ref.r.node_bytes);
-        cJSON *fe = cJSON_AddObjectToObject(fl, "effects");
-        for (int e = 0; e < CBVH_FX_COUNT; e++)
-            if (d.effect[e].enabled)
-                cJSON_AddItemToObject(fe, cbvh_effect_name((cbvh_effect)e),
-                                      json_costs(&res.ref.r.fx[e], &res.ref.r.fx[e], 1, 1, &tp));
-        cJSON_AddItemToObject(fl, "total", json_costs(&ftot, &ftot, 1, 1, &tp));
-        cJSON *rows = cJSON_AddArrayToObject(root, "settings");
-        for (int i = 0; i < res.nrows; i++) {
-            const cbvh_sweep_run_t *r = &res.rows[i];
-            cJSON *row = cJSON_CreateObject();
-            cJSON_AddNumberToObject(row, "bits", r->s.bits);
-            cJSON_AddNumberToObject(row, "mant", r->s.mant);
-            cJSON_AddNumberToObject(row, "min_scale", r->s.min_scale);
-            cJSON_AddNumberToObject(row, "node_bytes", (double)r->r.node_bytes);
-            cJSON_AddBoolToObject(row, "same_hits", r->same);
-            if (!r->same) cJSON_AddStringToObject(row, "first_difference", r->why);
-            cJSON *ef = cJSON_AddObjectToObject(row, "effects");
-            for (int e = 0; e < CBVH_FX_COUNT; e++)
-                if (d.effect[e].enabled)
-                    cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
-                                          json_costs(&r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
-                                                     res.ref.r.node_bytes, &tp));
-            cbvh_fx_stats t = cbvh_fx_total(&r->r);
-            cJSON_AddItemToObject(row, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
-            cJSON_AddItemToArray(rows, row);
-        }
-        cJSON *fj = res.nextra ? cJSON_AddArrayToObject(root, "formats") : NULL;
-        for (int k = 0; k < res.nextra; k++) {
-            const cbvh_sweep_run_t *r = &res.extra[k];
-            cJSON *qj = cJSON_CreateObject();
-            cJSON_AddItemToArray(fj, qj);
-            cJSON_AddStringToObject(qj, "format", o.extra[k].name);
-            cJSON_AddNumberToObject(qj, "mant", r->s.mant);
-            cJSON_AddNumberToObject(qj, "node_bytes", (double)r->r.node_bytes);
-            cJSON_AddNumberToObject(qj, "qbvh_stack", (double)r->r.units.qbvh_stack);
-            cJSON_AddNumberToObject(qj, "ray_sphere", (double)r->r.units.ray_sphere);
-            cJSON_AddBoolToObject(qj, "same_hits", r->same);
-            if (!r->same) cJSON_AddStringToObject(qj, "first_difference", r->why);
-            cJSON *ef = cJSON_AddObjectToObject(qj, "effects");
-            for (int e = 0; e < CBVH_FX_COUNT; e++)
-                if (d.effect[e].enabled)
-                    cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
-                                          json_costs(&r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
-                                                     res.ref.r.node_bytes, &tp));
-            cbvh_fx_stats t = cbvh_fx_total(&r->r);
-            cJSON_AddItemToObject(qj, "total", json_costs(&t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp));
-        }
-        cJSON *kn = cJSON_AddArrayToObject(root, "knee");
-        for (int c = 0; c < ncombo; c++) {
-            cJSON *k = cJSON_CreateObject();
-            cJSON_AddNumberToObject(k, "mant", res.rows[c * nb].s.mant);
-            cJSON_AddNumberToObject(k, "min_scale", res.rows[c * nb].s.min_scale);
-            cJSON_AddNumberToObject(k, "tolerance", tol);
-            cJSON_AddNumberToObject(k, "reference_bits", o.bits_hi);
-            for (int m = 0; m < 4; m++)
-                if (knee[c][m])
-                    cJSON_AddNumberToObject(k, knee_keys[m], knee[c][m]);
-                else
-                    cJSON_AddNullToObject(k, knee_keys[m]); /* no ratio: the float BVH did none */
-            cJSON_AddItemToArray(kn, k);
-        }
-        cJSON_AddBoolToObject(root, "same_hits", res.all_same);
-        cJSON_AddNumberToObject(root, "heatmap_max_box_tests", used_max);
-        cJSON *wr = cJSON_AddArrayToObject(root, "files");
-        for (int k = 0; k < nwritten; k++) cJSON_AddItemToArray(wr, cJSON_CreateString(written[k]));
-        char *txt = cJSON_PrintUnformatted(root);
-        if (!txt) cbvh_out_of_memory("sweep JSON");
-        cbvh_json_fputs_utf8(txt, stdout); /* file names may hold bytes that are not UTF-8 */
-        putchar('\n');
-        free(txt);
-        cJSON_Delete(root);
-    } else if (!json) {
-        printf("scene %s: %s, %u triangles, %dx%d, %d spp, %d frame%s; %llu rays per setting\n", scene, d.mesh_spec,
-               d.mesh.ntris, res.width, res.height, res.spp, res.frames, res.frames > 1 ? "s" : "",
-               (unsigned long long)res.ref_rays);
-        printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
-               "(docs/timing_model.md)\n\n",
-               tp.box_cycles, tp.tri_cycles, tp.fetch_latency, tp.dram_bytes_per_cycle, tp.clock_mhz);
-        printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %7s %7s %7s %7s %7s %7s  %s\n", "setting", "effect", "rays",
-               "box/ray", "tri/ray", "B/ray", "model ns", "CPU us", "box", "tri", "bytes", "memory", "model", "CPU",
-               "hits");
-        printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
-               "relative to the float BVH ----------------------------");
-        char name[48];
-        for (int i = -1; i < res.nrows + res.nextra; i++) {
-            const cbvh_sweep_run_t *r = i < 0 ? &res.ref : i >= res.nrows ? &res.extra[i - res.nrows] : &res.rows[i];
-            if (i < 0)
-                snprintf(name, sizeof name, "float");
-            else if (i >= res.nrows && o.extra[i - res.nrows].format == CBVH_FORMAT_QBVH)
-                snprintf(name, sizeof name, "qbvh M=%d", r->s.mant);
-            else if (i >= res.nrows)
-                snprintf(name, sizeof name, "%s", o.extra[i - res.nrows].name);
-            else
-                snprintf(name, sizeof name, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
-            const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
-            for (int e = 0; e < CBVH_FX_COUNT; e++)
-                if (d.effect[e].enabled)
-                    text_row(name, cbvh_effect_name((cbvh_effect)e), &r->r.fx[e], &res.ref.r.fx[e], r->r.node_bytes,
-                             res.ref.r.node_bytes, &tp, same);
-            cbvh_fx_stats t = cbvh_fx_total(&r->r);
-            text_row(name, "total", &t, &ftot, r->r.node_bytes, res.ref.r.node_bytes, &tp, same);
-        }
-        printf("\nnode memory: float BVH %llu B", (unsigned long long)res.ref.r.node_bytes);
-        for (int b = 0; b < nb; b++) printf(", N=%d %llu B", res.rows[b].s.bits, (unsigned long long)res.rows[b].r.node_bytes);
-        for (int k = 0; k < res.nextra; k++)
-            printf(", %s %llu B", o.extra[k].name, (unsigned long long)res.extra[k].r.node_bytes);
-        printf("\n");
-        printf("knee = smallest N from which every finer N costs at most %ld%% more than N=%d (totals over effects):\n",
-               knee_pct, o.bits_hi);
-        int no_knee = 0;
-        for (int c = 0; c < ncombo; c++) {
-            printf("  M=%d E=%d:", res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale);
-            for (int m = 0; m < 4; m++) {
-                if (knee[c][m])
-                    printf("%s %s N=%d", m ? "," : "", metric_names[m], knee[c][m]);
-                else
-                    printf("%s %s -", m ? "," : "", metric_names[m]);
-                no_knee |= !knee[c][m];
-            }
-            printf("\n");
-        }
-        if (no_knee) printf("  (-: the float BVH did none of it, so there is no ratio and no knee)\n");
-        for (int c = 0; c < ncombo; c++)
-            for (int b = 0; b < nb; b++)
-                if (bits[b] == 6 && res.rows[c * nb].s.mant == CBVH_MANT_MAX) {
-                    printf("paper (Viitanen et al., CBVH at N=6): box tests x1.08, triangle tests x1.13; here (M=%d "
-                           "E=%d): box tests",
-                           res.rows[c * nb].s.mant, res.rows[c * nb].s.min_scale);
-                    print_x(relv[(size_t)SWEEP_BOX * res.nrows + c * nb + b]);
-                    printf(", triangle tests");
-                    print_x(relv[(size_t)SWEEP_TRI * res.nrows + c * nb + b]);
-                    printf("\n");
-                }
-        if (res.all_same)
-            printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
-                   "false misses) and render the same %dx%d image\n",
-                   res.nrows, res.nextra == 1 && o.extra[0].format == CBVH_FORMAT_QBVH ? " and the QBVH"
-                              : res.nextra                                            ? " and the other formats"
-                                                                                      : "",
-                   o.one_sided ? " (one-sided)" : "", (unsigned long long)res.ref_rays, res.width, res.height);
-        else {
-            for (int i = 0; i < res.nrows; i++)
-                if (!res.rows[i].same)
-                    printf("hits: N=%d M=%d E=%d DIFFERENT from the float BVH: %s\n", res.rows[i].s.bits,
-                           res.rows[i].s.mant, res.rows[i].s.min_scale, res.rows[i].why);
-            for (int k = 0; k < res.nextra; k++)
-                if (!res.extra[k].same)
-                    printf("hits: %s DIFFERENT from the float BVH: %s\n", o.extra[k].name, res.extra[k].why);
-        }
-        printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all\n", used_max);
-        for (int k = 0; k < nwritten; k++) printf("wrote %s\n", written[k]);
+    const cbvh_sweep_result *res = &f->res;
+    const cbvh_timing_params *tp = &f->tp;
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "scene", c->scene);
+    cJSON_AddStringToObject(root, "mesh", d->mesh_spec);
+    cJSON_AddNumberToObject(root, "triangles", d->mesh.ntris);
+    cJSON_AddNumberToObject(root, "width", res->width);
+    cJSON_AddNumberToObject(root, "height", res->height);
+    cJSON_AddNumberToObject(root, "spp", res->spp);
+    cJSON_AddNumberToObject(root, "frames", res->frames);
+    cJSON_AddNumberToObject(root, "rays", (double)res->ref_rays);
+    cJSON *tj = cJSON_AddObjectToObject(root, "timing");
+    cJSON_AddNumberToObject(tj, "box_cycles", tp->box_cycles);
+    cJSON_AddNumberToObject(tj, "tri_cycles", tp->tri_cycles);
+    cJSON_AddNumberToObject(tj, "fetch_latency", tp->fetch_latency);
+    cJSON_AddNumberToObject(tj, "dram_bytes_per_cycle", tp->dram_bytes_per_cycle);
+    cJSON_AddNumberToObject(tj, "clock_mhz", tp->clock_mhz);
+    cJSON *fl = cJSON_AddObjectToObject(root, "float");
+    cJSON_AddNumberToObject(fl, "node_bytes", (double)res->ref.r.node_bytes);
+    cJSON *fe = cJSON_AddObjectToObject(fl, "effects");
+    for (int e = 0; e < CBVH_FX_COUNT; e++)
+        if (d->effect[e].enabled)
+            cJSON_AddItemToObject(fe, cbvh_effect_name((cbvh_effect)e),
+                                  json_costs(&res->ref.r.fx[e], &res->ref.r.fx[e], 1, 1, tp));
+    cJSON_AddItemToObject(fl, "total", json_costs(&f->ftot, &f->ftot, 1, 1, tp));
+    cJSON *rows = cJSON_AddArrayToObject(root, "settings");
+    for (int i = 0; i < res->nrows; i++) {
+        const cbvh_sweep_run_t *r = &res->rows[i];
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddNumberToObject(row, "bits", r->s.bits);
+        cJSON_AddNumberToObject(row, "mant", r->s.mant);
+        cJSON_AddNumberToObject(row, "min_scale", r->s.min_scale);
+        cJSON_AddNumberToObject(row, "node_bytes", (double)r->r.node_bytes);
+        cJSON_AddBoolToObject(row, "same_hits", r->same);
+        if (!r->same) cJSON_AddStringToObject(row, "first_difference", r->why);
+        json_effects(row, d, f, r);
+        cJSON_AddItemToArray(rows, row);
     }
-    if (first_bad >= res.nrows) {
-        const cbvh_sweep_run_t *r = &res.extra[first_bad - res.nrows];
-        if (o.extra[first_bad - res.nrows].format == CBVH_FORMAT_QBVH)
+    cJSON *fj = res->nextra ? cJSON_AddArrayToObject(root, "formats") : NULL;
+    for (int k = 0; k < res->nextra; k++) {
+        const cbvh_sweep_run_t *r = &res->extra[k];
+        cJSON *qj = cJSON_CreateObject();
+        cJSON_AddItemToArray(fj, qj);
+        cJSON_AddStringToObject(qj, "format", c->run.extra[k].name);
+        cJSON_AddNumberToObject(qj, "mant", r->s.mant);
+        cJSON_AddNumberToObject(qj, "node_bytes", (double)r->r.node_bytes);
+        cJSON_AddNumberToObject(qj, "qbvh_stack", (double)r->r.units.qbvh_stack);
+        cJSON_AddNumberToObject(qj, "ray_sphere", (double)r->r.units.ray_sphere);
+        cJSON_AddBoolToObject(qj, "same_hits", r->same);
+        if (!r->same) cJSON_AddStringToObject(qj, "first_difference", r->why);
+        json_effects(qj, d, f, r);
+    }
+    cJSON *kn = cJSON_AddArrayToObject(root, "knee");
+    for (int k = 0; k < f->ncombo; k++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "mant", res->rows[k * f->nb].s.mant);
+        cJSON_AddNumberToObject(o, "min_scale", res->rows[k * f->nb].s.min_scale);
+        cJSON_AddNumberToObject(o, "tolerance", f->tol);
+        cJSON_AddNumberToObject(o, "reference_bits", c->run.bits_hi);
+        for (int m = 0; m < 4; m++)
+            if (f->knee[k][m])
+                cJSON_AddNumberToObject(o, knee_keys[m], f->knee[k][m]);
+            else
+                cJSON_AddNullToObject(o, knee_keys[m]); /* no ratio: the float BVH did none */
+        cJSON_AddItemToArray(kn, o);
+    }
+    cJSON_AddBoolToObject(root, "same_hits", res->all_same);
+    cJSON_AddNumberToObject(root, "heatmap_max_box_tests", w->heat_max);
+    cJSON *wr = cJSON_AddArrayToObject(root, "files");
+    for (int k = 0; k < w->nwritten; k++) cJSON_AddItemToArray(wr, cJSON_CreateString(w->written[k]));
+    cbvh_json_print(root, stdout);
+    cJSON_Delete(root);
+}
+
+/* The table's name of row i (-1 = the float BVH, nrows.. = the other formats). */
+static const cbvh_sweep_run_t *row_named(const sweep_cli *c, const cbvh_sweep_result *res, int i, char *name,
+                                         size_t n) {
+    const cbvh_sweep_run_t *r = i < 0 ? &res->ref : i >= res->nrows ? &res->extra[i - res->nrows] : &res->rows[i];
+    if (i < 0)
+        snprintf(name, n, "float");
+    else if (i >= res->nrows && c->run.extra[i - res->nrows].format == CBVH_FORMAT_QBVH)
+        snprintf(name, n, "qbvh M=%d", r->s.mant);
+    else if (i >= res->nrows)
+        snprintf(name, n, "%s", c->run.extra[i - res->nrows].name);
+    else
+        snprintf(name, n, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
+    return r;
+}
+
+static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, const sweep_files *w) {
+    const cbvh_sweep_result *res = &f->res;
+    const cbvh_timing_params *tp = &f->tp;
+    int nb = f->nb;
+    printf("scene %s: %s, %u triangles, %dx%d, %d spp, %d frame%s; %llu rays per setting\n", c->scene, d->mesh_spec,
+           d->mesh.ntris, res->width, res->height, res->spp, res->frames, res->frames > 1 ? "s" : "",
+           (unsigned long long)res->ref_rays);
+    printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
+           "(docs/timing_model.md)\n\n",
+           tp->box_cycles, tp->tri_cycles, tp->fetch_latency, tp->dram_bytes_per_cycle, tp->clock_mhz);
+    printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %7s %7s %7s %7s %7s %7s  %s\n", "setting", "effect", "rays",
+           "box/ray", "tri/ray", "B/ray", "model ns", "CPU us", "box", "tri", "bytes", "memory", "model", "CPU",
+           "hits");
+    printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
+           "relative to the float BVH ----------------------------");
+    char name[48];
+    for (int i = -1; i < res->nrows + res->nextra; i++) {
+        const cbvh_sweep_run_t *r = row_named(c, res, i, name, sizeof name);
+        const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
+        for (int e = 0; e < CBVH_FX_COUNT; e++)
+            if (d->effect[e].enabled)
+                text_row(name, cbvh_effect_name((cbvh_effect)e), &r->r.fx[e], &res->ref.r.fx[e], r->r.node_bytes,
+                         res->ref.r.node_bytes, tp, same);
+        cbvh_fx_stats t = cbvh_fx_total(&r->r);
+        text_row(name, "total", &t, &f->ftot, r->r.node_bytes, res->ref.r.node_bytes, tp, same);
+    }
+    printf("\nnode memory: float BVH %llu B", (unsigned long long)res->ref.r.node_bytes);
+    for (int b = 0; b < nb; b++)
+        printf(", N=%d %llu B", res->rows[b].s.bits, (unsigned long long)res->rows[b].r.node_bytes);
+    for (int k = 0; k < res->nextra; k++)
+        printf(", %s %llu B", c->run.extra[k].name, (unsigned long long)res->extra[k].r.node_bytes);
+    printf("\n");
+    printf("knee = smallest N from which every finer N costs at most %ld%% more than N=%d (totals over effects):\n",
+           c->knee_pct, c->run.bits_hi);
+    int no_knee = 0;
+    for (int k = 0; k < f->ncombo; k++) {
+        printf("  M=%d E=%d:", res->rows[k * nb].s.mant, res->rows[k * nb].s.min_scale);
+        for (int m = 0; m < 4; m++) {
+            if (f->knee[k][m])
+                printf("%s %s N=%d", m ? "," : "", metric_names[m], f->knee[k][m]);
+            else
+                printf("%s %s -", m ? "," : "", metric_names[m]);
+            no_knee |= !f->knee[k][m];
+        }
+        printf("\n");
+    }
+    if (no_knee) printf("  (-: the float BVH did none of it, so there is no ratio and no knee)\n");
+    for (int k = 0; k < f->ncombo; k++)
+        for (int b = 0; b < nb; b++)
+            if (f->bits[b] == 6 && res->rows[k * nb].s.mant == CBVH_MANT_MAX) {
+                printf("paper (Viitanen et al., CBVH at N=6): box tests x1.08, triangle tests x1.13; here (M=%d "
+                       "E=%d): box tests",
+                       res->rows[k * nb].s.mant, res->rows[k * nb].s.min_scale);
+                print_x(f->relv[(size_t)SWEEP_BOX * res->nrows + k * nb + b]);
+                printf(", triangle tests");
+                print_x(f->relv[(size_t)SWEEP_TRI * res->nrows + k * nb + b]);
+                printf("\n");
+            }
+    if (res->all_same)
+        printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
+               "false misses) and render the same %dx%d image\n",
+               res->nrows, res->nextra == 1 && c->run.extra[0].format == CBVH_FORMAT_QBVH ? " and the QBVH"
+                           : res->nextra                                               ? " and the other formats"
+                                                                                       : "",
+               c->run.one_sided ? " (one-sided)" : "", (unsigned long long)res->ref_rays, res->width, res->height);
+    else {
+        for (int i = 0; i < res->nrows; i++)
+            if (!res->rows[i].same)
+                printf("hits: N=%d M=%d E=%d DIFFERENT from the float BVH: %s\n", res->rows[i].s.bits,
+                       res->rows[i].s.mant, res->rows[i].s.min_scale, res->rows[i].why);
+        for (int k = 0; k < res->nextra; k++)
+            if (!res->extra[k].same)
+                printf("hits: %s DIFFERENT from the float BVH: %s\n", c->run.extra[k].name, res->extra[k].why);
+    }
+    printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all\n", w->heat_max);
+    for (int k = 0; k < w->nwritten; k++) printf("wrote %s\n", w->written[k]);
+}
+
+/* The first setting whose hits differ, and a file not written: one line
+ * each on stderr.  The exit status. */
+static int report(const sweep_cli *c, const sweep_figures *f, const sweep_files *w) {
+    const cbvh_sweep_result *res = &f->res;
+    for (int i = 0; i < res->nrows + res->nextra; i++) {
+        const cbvh_sweep_run_t *r = i < res->nrows ? &res->rows[i] : &res->extra[i - res->nrows];
+        if (r->same) continue;
+        if (i < res->nrows)
+            fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits,
+                    r->s.mant, r->s.min_scale, r->why);
+        else if (c->run.extra[i - res->nrows].format == CBVH_FORMAT_QBVH)
             fprintf(stderr, "cbvh sweep: qbvh M=%d differs from the float BVH: %s\n", r->s.mant, r->why);
         else
-            fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", o.extra[first_bad - res.nrows].name,
+            fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", c->run.extra[i - res->nrows].name,
                     r->why);
-    } else if (first_bad >= 0) {
-        const cbvh_sweep_run_t *r = &res.rows[first_bad];
-        fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits, r->s.mant,
-                r->s.min_scale, r->why);
+        break;
     }
-    if (nfailed)
-        fprintf(stderr, "cbvh sweep: %s%s\n", failed,
-                nfailed > 1 ? " (and more output files not written)" : "");
-    free(x);
-    free(bits);
-    free(relv);
-    cbvh_sweep_free(&res);
+    if (w->nfailed)
+        fprintf(stderr, "cbvh sweep: %s%s\n", w->failed, w->nfailed > 1 ? " (and more output files not written)" : "");
+    int status = res->all_same ? 0 : 1;
+    return w->nfailed && !status ? 2 : status; /* an output file not written */
+}
+
+int cmd_sweep(int argc, char **argv) {
+    sweep_cli c;
+    int rc = parse_options(argc, argv, &c);
+    if (rc) return rc == 1 ? 0 : 2;
+    if (validate_options(&c)) return 2;
+    cbvh_scene_desc d;
+    char err[1024];
+    if (cbvh_scene_file_open(c.scene, &d, err, sizeof err)) {
+        fprintf(stderr, "cbvh sweep: %s\n", err);
+        return 2;
+    }
+    sweep_figures f;
+    if (validate_run(&c) || compute(&c, &d, &f)) {
+        cbvh_scene_desc_free(&d);
+        return 2;
+    }
+    sweep_files w;
+    write_files(&c, &d, &f, &w);
+    /* A file not written: no JSON (its "files" would pass for a complete run),
+     * only the error line, as trace and run print no JSON on an error. */
+    if (c.json && !w.nfailed)
+        write_json(&c, &d, &f, &w);
+    else if (!c.json)
+        write_text(&c, &d, &f, &w);
+    rc = report(&c, &f, &w);
+    free_figures(&f);
     cbvh_scene_desc_free(&d);
-    return status;
+    return rc;
 }

@@ -1,5 +1,6 @@
 /* cbvh: host tool of the low-precision ray-tracing accelerator kit. */
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,9 +37,16 @@ int cbvh_bad_option(const char *cmd, char **argv, int optind_now) {
     return 2;
 }
 
+int cbvh_unknown_option(const char *cmd, char **argv, int optind_now) {
+    fprintf(stderr, "%s: unknown option '%s' (see %s --help)\n", cmd, optind_now > 0 ? argv[optind_now - 1] : "", cmd);
+    return 2;
+}
+
 /* Results go to stdout, often redirected: a full disk or a closed pipe must
  * not pass as success with the table or JSON lost.  Exit 2 unless the command
- * already failed. */
+ * already failed.  (SIGPIPE is ignored, so a closed pipe is a write error
+ * here too, not a silent death; stdio keeps the unwritten bytes, so the
+ * fclose retries them and errno names the cause.) */
 static int finish_stdout(int rc) {
     errno = 0;
     int bad = ferror(stdout);
@@ -62,6 +70,7 @@ static void on_out_of_memory(const char *what) {
 
 int main(int argc, char **argv) {
     cbvh_set_oom_handler(on_out_of_memory);
+    signal(SIGPIPE, SIG_IGN); /* a closed pipe: EPIPE, reported by finish_stdout */
     if (argc < 2) {
         usage(stderr);
         return 2;

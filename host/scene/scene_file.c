@@ -16,6 +16,7 @@
 #include "cbvh/oom.h"
 #include "scene/scene_load.h"
 #include "trace/timing_model.h"
+#include "util/json.h"
 
 static const char *const fx_names[CBVH_FX_COUNT] = {"primary",          "hard_shadows", "soft_shadows",
                                                     "ambient_occlusion", "mirror",       "diffuse_bounce"};
@@ -417,6 +418,14 @@ static int resolve_mesh(pctx *c, const char *mesh, cbvh_scene_desc *d) {
     return 0;
 }
 
+/* The line of text that position at is on. */
+static int line_at(const char *text, const char *at) {
+    int line = 1;
+    if (at && at >= text)
+        for (const char *p = text; p < at && *p; p++) line += *p == '\n';
+    return line;
+}
+
 int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *d, char *err, size_t errlen) {
     memset(d, 0, sizeof *d);
     pctx c = {path, err, errlen};
@@ -424,11 +433,14 @@ int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *d
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
     if (!root) {
-        const char *at = cJSON_GetErrorPtr();
-        int line = 1;
-        if (at && at >= text)
-            for (const char *p = text; p < at && *p; p++) line += *p == '\n';
-        fail(&c, NULL, "line %d: not valid JSON", line);
+        fail(&c, NULL, "line %d: not valid JSON", line_at(text, cJSON_GetErrorPtr()));
+        return -1;
+    }
+    /* cJSON ends a string at a \u0000 escape: "a.obj\u0000x" would load a.obj. */
+    size_t len = strlen(text), nul = cbvh_json_find_nul(text, len);
+    if (nul < len) {
+        cJSON_Delete(root);
+        fail(&c, NULL, "line %d: a string holds \\u0000 (NUL), which no name or path can hold", line_at(text, text + nul));
         return -1;
     }
     int rc = -1;

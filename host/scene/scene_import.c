@@ -18,7 +18,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <cjson/cJSON.h>
+
 #include "scene/scene_load.h"
+#include "util/json.h"
 
 static void xform(const struct aiMatrix4x4 *m, const struct aiVector3D *v, float out[3]) {
     out[0] = m->a1 * v->x + m->a2 * v->y + m->a3 * v->z + m->a4;
@@ -618,13 +621,19 @@ done:
 /* assimp's glTF importers drop faces with out-of-range indices, and the
  * indices left over when a triangle list is not a multiple of 3, with only a
  * log warning ("... were dropped."), as its PLY reader does for a record it
- * cannot parse (it reads zeros); a warning like those fails the import. */
+ * cannot parse (it reads zeros) and its OBJ reader for an 'f' line without
+ * indices (an error in the log, "Ignoring empty face", and none in the
+ * result); a message like those fails the import. */
 typedef struct {
     char msg[200];
 } dropped_note;
 
 static void note_dropped(const char *message, char *user) {
     dropped_note *d = (dropped_note *)user;
+    if (!d->msg[0] && strstr(message, "Ignoring empty face")) {
+        snprintf(d->msg, sizeof d->msg, "a face with no vertices (an 'f' line without indices), which the importer drops");
+        return;
+    }
     if (d->msg[0] || strncmp(message, "Warn", 4) != 0 ||
         !(strstr(message, " were dropped") || strstr(message, "Unable to parse property instance")))
         return;
@@ -703,116 +712,19 @@ fail:
 /* ---- the import's time limit --------------------------------------------
  * The limit (below) grows with the bytes assimp has to read, and for a
  * .gltf/.glb these include the files its "buffers" (and "images") name by
- * relative URI: a 1 KB .gltf can point at a 300 MB .bin.  So the JSON is
- * scanned for those URIs here, with a small skip-parser that only follows
- * buffers[].uri and images[].uri (an array in glTF 2, an object keyed by id
- * in glTF 1); malformed JSON just ends the scan (assimp reports it). */
+ * relative URI: a 1 KB .gltf can point at a 300 MB .bin.  assimp does not
+ * say which files it will read before it reads them (and the import is what
+ * may hang), so the JSON is read here with cJSON for buffers[].uri and
+ * images[].uri (an array in glTF 2, an object keyed by id in glTF 1).  JSON
+ * that does not parse counts nothing: assimp's parser rejects it before it
+ * reads any buffer. */
 enum {
-    REF_MAX = 1024,      /* distinct files counted */
-    URI_MAX = 4096,      /* URIs looked at (each costs a stat) */
-    JSON_DEPTH_MAX = 64, /* nesting */
+    REF_MAX = 1024,            /* distinct files counted */
+    URI_MAX = 4096,            /* URIs looked at (each costs a stat) */
+    GLTF_JSON_MAX = 256 << 20, /* JSON bytes read: a larger file's own size already gives 256+ s */
 };
 
-typedef struct {
-    FILE *f;
-    long long left; /* bytes of JSON still to read (the GLB chunk), or -1 */
-    int bad;        /* malformed or too deep: stop */
-} json_in;
-
-static int jpeek(json_in *j) {
-    if (j->bad || j->left == 0) return -1;
-    int c = getc_unlocked(j->f);
-    if (c != EOF) ungetc(c, j->f);
-    return c == EOF ? -1 : c;
-}
-
-static int jget(json_in *j) {
-    if (j->bad || j->left == 0) return -1;
-    int c = getc_unlocked(j->f);
-    if (c == EOF) return -1;
-    if (j->left > 0) j->left--;
-    return c;
-}
-
-static void jspace(json_in *j) {
-    int c;
-    while ((c = jpeek(j)) == ' ' || c == '\t' || c == '\n' || c == '\r') jget(j);
-}
-
-/* Append code point u as UTF-8 to out (n used of cap); sets *over if it does
- * not fit (the string is then not used). */
-static void put_utf8(char *out, size_t cap, size_t *n, unsigned long u, int *over) {
-    unsigned char b[4];
-    size_t k;
-    if (u < 0x80) b[0] = (unsigned char)u, k = 1;
-    else if (u < 0x800) b[0] = (unsigned char)(0xC0 | u >> 6), b[1] = (unsigned char)(0x80 | (u & 0x3F)), k = 2;
-    else if (u < 0x10000)
-        b[0] = (unsigned char)(0xE0 | u >> 12), b[1] = (unsigned char)(0x80 | (u >> 6 & 0x3F)),
-        b[2] = (unsigned char)(0x80 | (u & 0x3F)), k = 3;
-    else
-        b[0] = (unsigned char)(0xF0 | u >> 18), b[1] = (unsigned char)(0x80 | (u >> 12 & 0x3F)),
-        b[2] = (unsigned char)(0x80 | (u >> 6 & 0x3F)), b[3] = (unsigned char)(0x80 | (u & 0x3F)), k = 4;
-    if (!out || *n + k >= cap) {
-        *over = 1;
-        return;
-    }
-    memcpy(out + *n, b, k);
-    *n += k;
-}
-
 static int hexval(int c) { return isdigit(c) ? c - '0' : isxdigit(c) ? tolower(c) - 'a' + 10 : -1; }
-
-static long jhex4(json_in *j) {
-    long v = 0;
-    for (int i = 0; i < 4; i++) {
-        int d = hexval(jget(j));
-        if (d < 0) return -1;
-        v = v * 16 + d;
-    }
-    return v;
-}
-
-/* A string after its opening quote, decoded into out (cap bytes, may be
- * NULL to skip).  1 if it fit in out, 0 if not (or skipped), -1 malformed. */
-static int jstring(json_in *j, char *out, size_t cap) {
-    size_t n = 0;
-    int over = out == NULL;
-    for (;;) {
-        int c = jget(j);
-        if (c < 0) return j->bad = 1, -1;
-        if (c == '"') break;
-        unsigned long u = (unsigned long)c;
-        if (c == '\\') {
-            static const char names[] = "\"\\/bfnrt", codes[] = "\"\\/\b\f\n\r\t";
-            const char *esc = NULL;
-            c = jget(j);
-            if (c == 'u') {
-                long h = jhex4(j);
-                if (h < 0) return j->bad = 1, -1;
-                u = (unsigned long)h;
-                if (u >= 0xD800 && u < 0xDC00) { /* a surrogate pair */
-                    long lo = jget(j) == '\\' && jget(j) == 'u' ? jhex4(j) : -1;
-                    if (lo < 0xDC00 || lo >= 0xE000) return j->bad = 1, -1;
-                    u = 0x10000 + ((u - 0xD800) << 10) + (unsigned long)(lo - 0xDC00);
-                }
-                if (u == 0) over = 1; /* a NUL cannot be in a path */
-            } else if (c > 0 && (esc = strchr(names, c)) != NULL) {
-                u = (unsigned char)codes[esc - names];
-            } else {
-                return j->bad = 1, -1;
-            }
-            put_utf8(out, cap, &n, u, &over);
-        } else if (c == 0) {
-            over = 1; /* a NUL cannot be in a path */
-        } else if (!over && n + 1 < cap) {
-            out[n++] = (char)c; /* raw bytes: UTF-8 passes through */
-        } else {
-            over = 1;
-        }
-    }
-    if (out && cap) out[over ? 0 : n] = 0;
-    return !over;
-}
 
 typedef struct {
     char dir[PATH_MAX]; /* the .gltf's folder with its '/', or "" */
@@ -821,7 +733,6 @@ typedef struct {
     dev_t dev[REF_MAX];
     ino_t ino[REF_MAX];
     int n, tried;
-    char uri[PATH_MAX];
 } gltf_refs;
 
 /* Count the file `uri` names, once per file: a limit that grew with each
@@ -863,115 +774,69 @@ static void add_ref(gltf_refs *r, const char *uri) {
     r->bytes += (long long)st.st_size;
 }
 
-/* What a value is to the scan: nothing, the "buffers"/"images" list, or one
- * entry of that list (whose "uri" counts). */
-enum { J_SKIP, J_LIST, J_ENTRY, J_ROOT };
-
-static void jvalue(json_in *j, int role, int depth, gltf_refs *r);
-
-/* An object or array after its opening bracket. */
-static void jcontainer(json_in *j, int close, int role, int depth, gltf_refs *r) {
-    if (depth > JSON_DEPTH_MAX) {
-        j->bad = 1;
-        return;
-    }
-    jspace(j);
-    if (jpeek(j) == close) {
-        jget(j);
-        return;
-    }
-    for (;;) {
-        int member = J_SKIP;
-        char key[16];
-        jspace(j);
-        if (close == '}') {
-            if (jget(j) != '"') {
-                j->bad = 1;
-                return;
-            }
-            int fit = jstring(j, key, sizeof key);
-            if (fit < 0) return;
-            jspace(j);
-            if (jget(j) != ':') {
-                j->bad = 1;
-                return;
-            }
-            if (fit && role == J_ROOT && (!strcmp(key, "buffers") || !strcmp(key, "images"))) member = J_LIST;
-            else if (role == J_LIST) member = J_ENTRY;
-            else if (fit && role == J_ENTRY && !strcmp(key, "uri")) {
-                jspace(j);
-                if (jpeek(j) == '"') {
-                    jget(j);
-                    int ok = jstring(j, r->uri, sizeof r->uri);
-                    if (ok < 0) return;
-                    if (ok) add_ref(r, r->uri);
-                    goto next;
-                }
-            }
-        } else if (role == J_LIST) {
-            member = J_ENTRY;
-        }
-        jvalue(j, member, depth + 1, r);
-    next:
-        if (j->bad) return;
-        jspace(j);
-        int c = jget(j);
-        if (c == close) return;
-        if (c != ',') {
-            j->bad = 1;
-            return;
-        }
+/* The "uri" of each entry of the list root[key]. */
+static void add_refs(gltf_refs *r, const cJSON *root, const char *key) {
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(root, key), *e;
+    if (!cJSON_IsArray(list) && !cJSON_IsObject(list)) return;
+    cJSON_ArrayForEach(e, list) {
+        const cJSON *uri = cJSON_GetObjectItemCaseSensitive(e, "uri");
+        if (cJSON_IsString(uri)) add_ref(r, uri->valuestring);
     }
 }
 
-static void jvalue(json_in *j, int role, int depth, gltf_refs *r) {
-    jspace(j);
-    int c = jget(j);
-    if (c == '{') {
-        jcontainer(j, '}', role, depth, r);
-    } else if (c == '[') {
-        jcontainer(j, ']', role == J_LIST ? J_LIST : J_SKIP, depth, r); /* glTF 2's lists */
-    } else if (c == '"') {
-        jstring(j, NULL, 0);
-    } else if (c == '-' || isalnum(c)) { /* numbers, true, false, null */
-        while ((c = jpeek(j)) >= 0 && (isalnum(c) || c == '+' || c == '-' || c == '.')) jget(j);
+/* The JSON of the glTF at path, a regular file: the whole .gltf, or a GLB's
+ * JSON chunk (any extension); NULL for anything else.  *len its length. */
+static char *gltf_json(const char *path, size_t *len) {
+    const char *dot = strrchr(path, '.');
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    unsigned char h[20];
+    size_t got = fread(h, 1, sizeof h, f);
+    long long start = 0, want = -1; /* -1: to the end of the file */
+    int ok = 1;
+    if (got >= 4 && memcmp(h, "glTF", 4) == 0) {
+        /* GLB: 12-byte header, then (glTF 2) the JSON chunk's length and
+         * type, or (glTF 1) the content's length and format: same place */
+        ok = got == 20 && (h[4] != 2 || memcmp(h + 16, "JSON", 4) == 0);
+        start = 20;
+        want = (long long)h[12] | (long long)h[13] << 8 | (long long)h[14] << 16 | (long long)h[15] << 24;
     } else {
-        j->bad = 1;
+        ok = dot && strcasecmp(dot, ".gltf") == 0;
     }
+    struct stat st;
+    char *text = NULL;
+    if (ok && fstat(fileno(f), &st) == 0 && st.st_size >= start) {
+        if (want < 0 || want > st.st_size - start) want = st.st_size - start;
+        if (want <= GLTF_JSON_MAX && (text = malloc((size_t)want + 1)) && fseek(f, (long)start, SEEK_SET) == 0) {
+            *len = fread(text, 1, (size_t)want, f);
+            text[*len] = 0;
+        }
+    }
+    fclose(f);
+    return text;
 }
 
 /* Bytes of the files the glTF (JSON or GLB) at path, a regular file,
  * references. */
 static long long gltf_referenced_bytes(const char *path) {
-    const char *dot = strrchr(path, '.');
-    int gltf = dot && strcasecmp(dot, ".gltf") == 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    json_in j = {f, -1, 0};
-    unsigned char h[20];
-    size_t got = fread(h, 1, sizeof h, f);
-    if (got >= 4 && memcmp(h, "glTF", 4) == 0) {
-        /* GLB: 12-byte header, then (glTF 2) the JSON chunk's length and
-         * type, or (glTF 1) the content's length and format: same place */
-        if (got < 20 || (h[4] == 2 && memcmp(h + 16, "JSON", 4) != 0)) j.bad = 1;
-        j.left = (long long)h[12] | (long long)h[13] << 8 | (long long)h[14] << 16 | (long long)h[15] << 24;
-    } else if (gltf) {
-        rewind(f);
-    } else {
-        j.bad = 1; /* not a glTF: nothing to follow */
-    }
-    gltf_refs *r = calloc(1, sizeof *r);
+    size_t len = 0;
+    char *text = gltf_json(path, &len);
+    /* a NUL would end a URI early: "big.bin\u0000x" is not big.bin */
+    cJSON *root = text && cbvh_json_find_nul(text, len) == len ? cJSON_ParseWithLength(text, len) : NULL;
+    free(text);
+    gltf_refs *r = root ? calloc(1, sizeof *r) : NULL;
     const char *slash = strrchr(path, '/');
     size_t dirlen = slash ? (size_t)(slash - path + 1) : 0;
     long long bytes = 0;
-    if (r && !j.bad && dirlen < sizeof r->dir) { /* else the file's own size only */
+    if (r && dirlen < sizeof r->dir) { /* else the file's own size only */
         memcpy(r->dir, path, dirlen);
         r->dirlen = dirlen;
-        jvalue(&j, J_ROOT, 0, r);
+        add_refs(r, root, "buffers");
+        add_refs(r, root, "images");
         bytes = r->bytes;
     }
     free(r);
-    fclose(f);
+    cJSON_Delete(root);
     return bytes;
 }
 

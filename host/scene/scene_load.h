@@ -17,7 +17,9 @@ int cbvh_scene_import(const char *path, cbvh_scene *out, char *err, size_t errle
 
 /* The time cbvh_scene_import gives the importer before it is stopped as
  * hung, in ms: 5 s plus 1 s per MB of the file and, for glTF (.gltf, .glb),
- * of the distinct files its buffers and images name by relative URI. */
+ * of the distinct files its buffers and images name by relative URI (read
+ * with cJSON; JSON that does not parse, holds a NUL or is over 256 MiB
+ * counts the file's own size only). */
 long long cbvh_scene_import_limit_ms(const char *path);
 
 /* Procedural scenes (names for cbvh_scene_open); size 0 = the default, a

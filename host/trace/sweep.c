@@ -213,6 +213,12 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
     res->ref.s = (cbvh_sweep_setting){0, CBVH_MANT_MAX, o->min_scale[0]};
     if (run_one(&c, &res->ref, CBVH_FORMAT_FLOAT, NULL, err, errlen)) goto out;
     res->ref_rays = c.nrec;
+    if (o->corrupt_setting >= 0 && o->corrupt_ray >= c.nrec) { /* a fault that never fires would pass */
+        snprintf(err, errlen, "--test-corrupt %d:%llu: no ray %llu, the sweep traces rays 0..%llu", o->corrupt_setting,
+                 (unsigned long long)o->corrupt_ray, (unsigned long long)o->corrupt_ray,
+                 (unsigned long long)c.nrec - 1);
+        goto out;
+    }
     res->all_same = 1;
     char label[72]; /* a format name (47 chars) and " M=" with its value fit */
     for (int i = 0; i < res->nrows; i++) {

@@ -43,7 +43,8 @@ typedef struct {
     int one_sided; /* triangles count only from their front side, every format (required by tlist culling) */
     /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows +
      * k = extra format k, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
-     * for a closest hit, the opposite answer for an any-hit ray). */
+     * for a closest hit, the opposite answer for an any-hit ray); a ray the
+     * float BVH did not trace is an error of cbvh_sweep_run. */
     int corrupt_setting;
     uint64_t corrupt_ray;
     void (*progress)(void *ctx, const char *label, int setting, int settings, int row, int rows);

@@ -14,12 +14,27 @@ typedef struct {
     const char *key, *text;
 } png_note;
 
-static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned h, int channels,
-                     const png_note *notes, int nnotes, char *err, size_t errlen) {
-    if (!path || !*path) {
-        snprintf(err, errlen, "png: empty output path");
-        return -1;
-    }
+/* libpng's own handlers print "libpng error: ..." / "libpng warning: ..." on
+ * stderr, a second line beside ours: its error message is kept for ours
+ * instead, and a warning (nothing that stops the write) is not printed. */
+typedef struct {
+    char msg[160];
+} png_errors;
+
+static void on_png_error(png_structp png, png_const_charp msg) {
+    png_errors *e = png_get_error_ptr(png);
+    snprintf(e->msg, sizeof e->msg, "%s", msg);
+    png_longjmp(png, 1);
+}
+
+static void on_png_warning(png_structp png, png_const_charp msg) {
+    (void)png;
+    (void)msg;
+}
+
+/* Size and channels (path only for the message); 0 or -1. */
+static int check_image(const char *path, const uint8_t *pix, unsigned w, unsigned h, int channels, char *err,
+                       size_t errlen) {
     if (!pix || w == 0 || h == 0 || w > 65535 || h > 65535) {
         snprintf(err, errlen, "png: %s: bad image size %ux%u (1..65535 each)", path, w, h);
         return -1;
@@ -28,6 +43,50 @@ static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned 
         snprintf(err, errlen, "png: %s: %d channels (1 = grey, 3 = RGB)", path, channels);
         return -1;
     }
+    return 0;
+}
+
+/* The PNG on f, flushed (not closed): 0, or -1 with the reason in why (the
+ * system's for a failed write, e.g. no space left, else libpng's). */
+static int png_stream(FILE *f, const uint8_t *pix, unsigned w, unsigned h, int channels, const png_note *notes,
+                      int nnotes, char *why, size_t whylen) {
+    png_errors perr = {""};
+    errno = 0; /* so a failed write below can be named (e.g. no space left) */
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &perr, on_png_error, on_png_warning);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    volatile int ok = 0;
+    if (png && info && !setjmp(png_jmpbuf(png))) {
+        png_init_io(png, f);
+        png_set_IHDR(png, info, w, h, 8, channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
+                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+        png_text txt[4];
+        int nt = nnotes < 4 ? nnotes : 4;
+        for (int i = 0; i < nt; i++) {
+            memset(&txt[i], 0, sizeof txt[i]);
+            txt[i].compression = PNG_TEXT_COMPRESSION_NONE;
+            txt[i].key = (png_charp)notes[i].key;
+            txt[i].text = (png_charp)notes[i].text;
+        }
+        if (nt) png_set_text(png, info, txt, nt);
+        png_write_info(png, info);
+        for (unsigned y = 0; y < h; y++) png_write_row(png, (png_const_bytep)(pix + (size_t)y * w * channels));
+        png_write_end(png, NULL);
+        ok = 1;
+    }
+    png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
+    int werr = fflush(f) != 0 || ferror(f);
+    if (ok && !werr) return 0;
+    snprintf(why, whylen, "%s", errno ? strerror(errno) : !ok && perr.msg[0] ? perr.msg : !ok ? "libpng error" : "I/O error");
+    return -1;
+}
+
+static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned h, int channels,
+                     const png_note *notes, int nnotes, char *err, size_t errlen) {
+    if (!path || !*path) {
+        snprintf(err, errlen, "png: empty output path");
+        return -1;
+    }
+    if (check_image(path, pix, w, h, channels, err, errlen)) return -1;
     size_t plen = strlen(path);
     char *tmp = malloc(plen + 16);
     if (!tmp) {
@@ -50,34 +109,14 @@ static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned 
         free(tmp);
         return -1;
     }
-    errno = 0; /* so a failed write below can be named (e.g. no space left) */
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
-    png_infop info = png ? png_create_info_struct(png) : NULL;
-    volatile int ok = 0;
-    if (png && info && !setjmp(png_jmpbuf(png))) {
-        png_init_io(png, f);
-        png_set_IHDR(png, info, w, h, 8, channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
-                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-        png_text txt[4];
-        int nt = nnotes < 4 ? nnotes : 4;
-        for (int i = 0; i < nt; i++) {
-            memset(&txt[i], 0, sizeof txt[i]);
-            txt[i].compression = PNG_TEXT_COMPRESSION_NONE;
-            txt[i].key = (png_charp)notes[i].key;
-            txt[i].text = (png_charp)notes[i].text;
-        }
-        if (nt) png_set_text(png, info, txt, nt);
-        png_write_info(png, info);
-        for (unsigned y = 0; y < h; y++) png_write_row(png, (png_const_bytep)(pix + (size_t)y * w * channels));
-        png_write_end(png, NULL);
-        ok = 1;
+    char why[200];
+    int bad = png_stream(f, pix, w, h, channels, notes, nnotes, why, sizeof why);
+    if (fclose(f) != 0 && !bad) {
+        snprintf(why, sizeof why, "%s", errno ? strerror(errno) : "I/O error");
+        bad = 1;
     }
-    png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
-    int werr = ferror(f);
-    if (fclose(f) != 0) werr = 1;
-    if (!ok || werr) { /* errno from the failed flush, e.g. no space left */
-        snprintf(err, errlen, "png: writing %s failed: %s", path,
-                 !ok ? "libpng error" : errno ? strerror(errno) : "I/O error");
+    if (bad) {
+        snprintf(err, errlen, "png: writing %s failed: %s", path, why);
         unlink(tmp);
         free(tmp);
         return -1;
@@ -90,6 +129,15 @@ static int write_png(const char *path, const uint8_t *pix, unsigned w, unsigned 
     }
     free(tmp);
     return 0;
+}
+
+int cbvh_png_write_stream(FILE *f, const uint8_t *pix, unsigned w, unsigned h, int channels, char *err,
+                          size_t errlen) {
+    char why[200];
+    if (check_image("(stream)", pix, w, h, channels, err, errlen)) return -1;
+    if (png_stream(f, pix, w, h, channels, NULL, 0, why, sizeof why) == 0) return 0;
+    snprintf(err, errlen, "png: writing failed: %s", why);
+    return -1;
 }
 
 int cbvh_png_write(const char *path, const uint8_t *pix, unsigned w, unsigned h, int channels, char *err,

@@ -7,11 +7,17 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 /* pix: h rows of w pixels, channels = 1 (grey) or 3 (RGB), row-major, no
  * padding.  w, h in 1 .. 65535. */
 int cbvh_png_write(const char *path, const uint8_t *pix, unsigned w, unsigned h, int channels, char *err,
                    size_t errlen);
+
+/* The same PNG on an open stream (standard output, a pipe), flushed but not
+ * closed; no temporary file, so a failed write may leave part of it there. */
+int cbvh_png_write_stream(FILE *f, const uint8_t *pix, unsigned w, unsigned h, int channels, char *err,
+                          size_t errlen);
 
 /* The heat-map colour map: t in [0, 1] (clamped; NaN -> 0) to RGB, dark blue
  * -> purple -> orange -> pale yellow, monotone in luminance. */

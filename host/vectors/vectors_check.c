@@ -3,13 +3,15 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
 
+#include "cbvh/oom.h"
 #include "link/backend.h"
-#include "cli/commands.h"
+#include "util/json.h"
 #include "vectors/manifest.h"
 #include "vectors/vecfile.h"
 
@@ -242,20 +244,32 @@ static void print_mismatch_text(FILE *f, const char *path, const cbvh_vecfile *v
     }
 }
 
-static void json_mismatch(FILE *f, const char *path, const cbvh_vecfile *vf, size_t i, const uint32_t *act) {
+/* A field value as the vector files write it: hex, the field's digits. */
+static void json_hex(cJSON *o, const char *key, int digits, uint32_t v) {
+    char hex[16];
+    snprintf(hex, sizeof hex, "%0*" PRIX32, digits, v);
+    cJSON_AddStringToObject(o, key, hex);
+}
+
+static cJSON *json_mismatch(const char *path, const cbvh_vecfile *vf, size_t i, const uint32_t *act) {
     const cbvh_layout *l = &vf->layout;
     const uint32_t *in = vf->in + i * (size_t)l->n_in, *exp = vf->out + i * (size_t)l->n_out;
-    fprintf(f, "{\"file\": ");
-    cbvh_json_str(path, f);
-    fprintf(f, ", \"line\": %zu, \"unit\": \"%s\", \"inputs\": {", vf->first_line + i, vf->unit->name);
-    for (int k = 0; k < l->n_in; k++)
-        fprintf(f, "%s\"%s\": \"%0*" PRIX32 "\"", k ? ", " : "", l->in[k].name, l->in[k].hex_digits, in[k]);
-    fprintf(f, "}, \"outputs\": [");
-    for (int k = 0; k < l->n_out; k++)
-        fprintf(f, "%s{\"field\": \"%s\", \"expected\": \"%0*" PRIX32 "\", \"actual\": \"%0*" PRIX32 "\", \"differs\": %s}",
-                k ? ", " : "", l->out[k].name, l->out[k].hex_digits, exp[k], l->out[k].hex_digits, act[k],
-                exp[k] != act[k] ? "true" : "false");
-    fprintf(f, "]}");
+    cJSON *m = cJSON_CreateObject();
+    cJSON_AddStringToObject(m, "file", path);
+    cJSON_AddNumberToObject(m, "line", (double)(vf->first_line + i));
+    cJSON_AddStringToObject(m, "unit", vf->unit->name);
+    cJSON *ins = cJSON_AddObjectToObject(m, "inputs");
+    for (int k = 0; k < l->n_in; k++) json_hex(ins, l->in[k].name, l->in[k].hex_digits, in[k]);
+    cJSON *outs = cJSON_AddArrayToObject(m, "outputs");
+    for (int k = 0; k < l->n_out; k++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "field", l->out[k].name);
+        json_hex(o, "expected", l->out[k].hex_digits, exp[k]);
+        json_hex(o, "actual", l->out[k].hex_digits, act[k]);
+        cJSON_AddBoolToObject(o, "differs", exp[k] != act[k]);
+        cJSON_AddItemToArray(outs, o);
+    }
+    return m;
 }
 
 static double now(void) {
@@ -281,8 +295,10 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
     int be_open = 0;
     uint32_t *act = NULL;
     size_t act_cap = 0;
-    int printed = 0, in_obj = 0;
+    int printed = 0;
     double t0 = now();
+    /* --json: one tree, printed once at the end (also after an error). */
+    cJSON *root = o.json ? cJSON_CreateObject() : NULL, *jfiles = NULL;
 
     if (collect(paths, npaths, log, &files, err, sizeof err) != 0) goto done;
     char berr[512] = "";
@@ -294,9 +310,8 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
     be_open = 1;
     snprintf(sum.backend, sizeof sum.backend, "%s", be.label);
     if (o.json) {
-        fprintf(out, "{\"backend\": ");
-        cbvh_json_str(be.label, out);
-        fprintf(out, ", \"files\": [");
+        cJSON_AddStringToObject(root, "backend", be.label);
+        jfiles = cJSON_AddArrayToObject(root, "files");
     } else {
         fprintf(out, "backend: %s\n", be.label);
     }
@@ -340,12 +355,13 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
         }
         const uint32_t *run_in = picked_in ? picked_in : vf.in;
         size_t pass = 0, fail = 0;
-        int shown_here = 0;
-        in_obj = o.json;
+        cJSON *jfile = NULL, *jmis = NULL; /* in the tree at once: an error below still shows the file */
         if (o.json) {
-            fprintf(out, "%s{\"file\": ", fi ? ", " : "");
-            cbvh_json_str(path, out);
-            fprintf(out, ", \"unit\": \"%s\", \"mismatches\": [", vf.unit->name);
+            jfile = cJSON_CreateObject();
+            cJSON_AddItemToArray(jfiles, jfile);
+            cJSON_AddStringToObject(jfile, "file", path);
+            cJSON_AddStringToObject(jfile, "unit", vf.unit->name);
+            jmis = cJSON_AddArrayToObject(jfile, "mismatches");
         }
         for (size_t off = 0; off < m; off += batch) {
             size_t cnt = m - off < batch ? m - off : batch;
@@ -369,19 +385,16 @@ int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_op
                 }
                 fail++;
                 if (printed < o.max_errors && !o.json) print_mismatch_text(out, path, &vf, v, a);
-                if (printed < o.max_errors && o.json) {
-                    fprintf(out, "%s", shown_here ? ", " : "");
-                    json_mismatch(out, path, &vf, v, a);
-                    shown_here++;
-                }
+                if (printed < o.max_errors && o.json) cJSON_AddItemToArray(jmis, json_mismatch(path, &vf, v, a));
                 printed++;
             }
         }
         free(pick);
         free(picked_in);
         if (o.json) {
-            fprintf(out, "], \"passed\": %zu, \"failed\": %zu, \"count\": %zu}", pass, fail, vf.count);
-            in_obj = 0;
+            cJSON_AddNumberToObject(jfile, "passed", (double)pass);
+            cJSON_AddNumberToObject(jfile, "failed", (double)fail);
+            cJSON_AddNumberToObject(jfile, "count", (double)vf.count);
         } else if (!o.quiet || fail) {
             fprintf(out, "%s: %zu passed, %zu failed", path, pass, fail);
             if (m < vf.count) fprintf(out, " (a sample of %zu of its %zu vectors)", m, vf.count);
@@ -403,16 +416,16 @@ done_json:
     sum.seconds = now() - t0;
     sum.vectors_per_second = sum.seconds > 0 ? (double)(sum.passed + sum.failed) / sum.seconds : 0;
     if (o.json) {
-        if (in_obj) fprintf(out, "]}");
-        fprintf(out, "], \"total\": {\"files\": %zu, \"passed\": %zu, \"failed\": %zu, \"seconds\": %.6f, "
-                     "\"vectors_per_second\": %.0f}, \"mismatches_shown\": %d, \"status\": %d",
-                sum.files, sum.passed, sum.failed, sum.seconds, sum.vectors_per_second,
-                printed < o.max_errors ? printed : o.max_errors, rc);
-        if (rc == CBVH_CHECK_BAD_INPUT) {
-            fprintf(out, ", \"error\": ");
-            cbvh_json_str(err, out);
-        }
-        fprintf(out, "}\n");
+        cJSON *t = cJSON_AddObjectToObject(root, "total");
+        cJSON_AddNumberToObject(t, "files", (double)sum.files);
+        cJSON_AddNumberToObject(t, "passed", (double)sum.passed);
+        cJSON_AddNumberToObject(t, "failed", (double)sum.failed);
+        cJSON_AddNumberToObject(t, "seconds", round(sum.seconds * 1e6) / 1e6); /* microseconds, as the text */
+        cJSON_AddNumberToObject(t, "vectors_per_second", round(sum.vectors_per_second));
+        cJSON_AddNumberToObject(root, "mismatches_shown", printed < o.max_errors ? printed : o.max_errors);
+        cJSON_AddNumberToObject(root, "status", rc);
+        if (rc == CBVH_CHECK_BAD_INPUT) cJSON_AddStringToObject(root, "error", err);
+        cbvh_json_print(root, out);
     } else if (rc != CBVH_CHECK_BAD_INPUT) {
         if (printed > o.max_errors)
             fprintf(out, "(%d more mismatches not shown; --max-errors raises the limit)\n", printed - o.max_errors);
@@ -422,25 +435,16 @@ done_json:
     goto finish;
 done:
     if (o.json) {
-        fprintf(out, "{\"status\": %d, \"error\": ", rc);
-        cbvh_json_str(err, out);
-        fprintf(out, "}\n");
+        cJSON_AddNumberToObject(root, "status", rc);
+        cJSON_AddStringToObject(root, "error", err);
+        cbvh_json_print(root, out);
     }
 finish:
+    cJSON_Delete(root);
     if (rc == CBVH_CHECK_BAD_INPUT) fprintf(log, "%s: %s\n", o.who ? o.who : "cbvh vectors check", err);
     if (be_open) cbvh_backend_close(&be);
     free(act);
     list_free(&files);
     if (o.summary) *o.summary = sum;
     return rc;
-}
-
-int cbvh_vectors_check_dir(const char *dir, const char *backend_spec, FILE *out) {
-    cbvh_check_opts o;
-    memset(&o, 0, sizeof o);
-    o.backend = backend_spec;
-    o.max_errors = 20;
-    o.out = out;
-    const char *paths[1] = {dir};
-    return cbvh_vectors_check(paths, 1, &o);
 }

@@ -38,8 +38,4 @@ typedef struct {
  * bad input is reported as one line on log. */
 int cbvh_vectors_check(const char *const *paths, int npaths, const cbvh_check_opts *opts);
 
-/* Convenience for one directory with default options (report on out,
- * notes and errors on stderr). */
-int cbvh_vectors_check_dir(const char *dir, const char *backend_spec, FILE *out);
-
 #endif

@@ -292,6 +292,21 @@ static void expect_text_error(const char *suffix, const char *text, const char *
     expect_error_prefix(suffix, text, strlen(text), want_fmt);
 }
 
+/* An OBJ 'f' line without indices: assimp drops the face with only a log
+ * message, so it is refused (as an OFF face of 0 vertices is); an undefined
+ * material alone changes no triangle and is not an error. */
+static void test_import_obj_empty_face(void **st) {
+    (void)st;
+    expect_text_error("bare.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf\nf 1 2 3\n",
+                      "cannot import '%s': a face with no vertices (an 'f' line without indices)");
+    expect_text_error("bare2.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf   \r\n",
+                      "cannot import '%s': a face with no vertices");
+    cbvh_scene s;
+    assert_int_equal(import_text("mtl.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nosuch\nf 1 2 3\n", &s), 0);
+    assert_int_equal(s.ntris, 1);
+    cbvh_scene_free(&s);
+}
+
 #define PLY_ASCII_HEAD(nv, nf)                                                                                  \
     "ply\nformat ascii 1.0\nelement vertex " #nv "\nproperty float x\nproperty float y\nproperty float z\n"     \
     "element face " #nf "\nproperty list uchar int vertex_indices\nend_header\n"
@@ -1346,6 +1361,7 @@ int main(void) {
         cmocka_unit_test(test_import_gltf_morph),
         cmocka_unit_test(test_import_gltf_nested_nodes),
         cmocka_unit_test(test_import_errors),
+        cmocka_unit_test(test_import_obj_empty_face),
         cmocka_unit_test(test_import_ply_counts),
         cmocka_unit_test(test_import_ply_binary_size),
         cmocka_unit_test(test_import_off_tokens),

@@ -1,7 +1,7 @@
 # cmake -DCBVH=... -DMESH=... -DWORK=... -P json_utf8.cmake
 # A file name that is not UTF-8 (here with the byte 0xFF) must not reach JSON
 # raw (invalid UTF-8): trace, sweep, run, study and vectors check write such a byte as
-# \u00ff (commands.h), and their output parses and names the file.
+# \u00ff (host/util/json.h), and their output parses and names the file.
 string(ASCII 255 ff)
 string(ASCII 195 191 ff_utf8) # U+00FF in UTF-8: what a JSON reader decodes \u00ff to
 file(REMOVE_RECURSE "${WORK}")

@@ -611,6 +611,15 @@ static void errors(void **state) {
         {"{\"mesh\": \"" MESH "\", \"camera\": {\"position\": [0,0,1], \"target\": [0,0,0], \"fov\": 40, "
          "\"fov\": 50}, \"effects\": [\"primary\"]}",
          "t.scene: camera.fov: given twice"},
+        /* a NUL ends a cJSON string: refused, not the name before it loaded */
+        {"{\"mesh\": \"" MESH "\\u0000.ply\", " CAMERA ", \"effects\": [\"primary\"]}",
+         "t.scene: line 1: a string holds \\u0000 (NUL), which no name or path can hold"},
+        {"{\"mesh\": \"" MESH "\",\n" CAMERA ",\n\"materials\": [{\"name\": \"a\\u0000b\", \"type\": \"diffuse\"}],"
+         " \"effects\": [\"primary\"]}",
+         "t.scene: line 3: a string holds \\u0000 (NUL)"},
+        /* an escaped backslash before "u0000" is no NUL: the name is looked for as written */
+        {"{\"mesh\": \"no\\\\u0000such.obj\", " CAMERA ", \"effects\": [\"primary\"]}",
+         "t.scene: mesh: cannot open 'no\\u0000such.obj'"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         cbvh_scene_desc d;
