@@ -131,31 +131,16 @@ typedef struct {
     int explicit_all;
 } heat_spec;
 
-/* A format name of --formats / --heatmap: "qbvh" or a tlist spec; the
- * canonical name goes to f.  0 or -1. */
-static int parse_format(const char *t, cbvh_sweep_format *f, char *err, size_t errlen) {
-    memset(f, 0, sizeof *f);
-    if (strcmp(t, "qbvh") == 0) {
-        f->format = CBVH_FORMAT_QBVH;
-        snprintf(f->name, sizeof f->name, "qbvh");
-        return 0;
-    }
-    if (cbvh_tlist_opts_parse(t, &f->tlist, err, errlen)) return -1;
-    f->format = CBVH_FORMAT_TLIST;
-    cbvh_tlist_opts_name(&f->tlist, f->name, sizeof f->name);
-    return 0;
-}
-
 static int parse_heat(const char *s, heat_spec *h) {
     memset(h, 0, sizeof *h);
     if (strcmp(s, "float") == 0) {
         h->is_float = 1;
         return 0;
     }
-    if (strcmp(s, "qbvh") == 0 || strncmp(s, "tlist", 5) == 0) {
+    if (cbvh_sweep_format_find(s)) {
         cbvh_sweep_format f;
         char e[160];
-        if (parse_format(s, &f, e, sizeof e)) return -1;
+        if (cbvh_sweep_format_parse(s, &f, e, sizeof e)) return -1;
         snprintf(h->fmt, sizeof h->fmt, "%s", f.name);
         return 0;
     }
@@ -382,8 +367,7 @@ int cmd_sweep(int argc, char **argv) {
             if (list_again(a, &heat_given)) return 2;
             int n0 = nheat;
             while (i + 1 < argc && argv[i + 1][0] != '-' && (strcmp(argv[i + 1], "float") == 0 ||
-                                                              strcmp(argv[i + 1], "qbvh") == 0 ||
-                                                              strncmp(argv[i + 1], "tlist", 5) == 0 ||
+                                                              cbvh_sweep_format_find(argv[i + 1]) ||
                                                               (argv[i + 1][0] >= '0' && argv[i + 1][0] <= '9'))) {
                 if (nheat == MAX_HEAT) {
                     fprintf(stderr, "cbvh sweep: --heatmap takes at most %d settings\n", MAX_HEAT);
@@ -418,9 +402,9 @@ int cmd_sweep(int argc, char **argv) {
                     continue;
                 }
                 cbvh_sweep_format f;
-                if (strcmp(t, "qbvh") != 0 && strncmp(t, "tlist", 5) != 0)
+                if (!cbvh_sweep_format_find(t))
                     bad = 1;
-                else if (parse_format(t, &f, ferr, sizeof ferr))
+                else if (cbvh_sweep_format_parse(t, &f, ferr, sizeof ferr))
                     bad = 2;
                 else if (o.nextra == CBVH_SWEEP_MAX_EXTRA) {
                     snprintf(ferr, sizeof ferr, "at most %d formats besides cbvh", CBVH_SWEEP_MAX_EXTRA);
@@ -439,7 +423,8 @@ int cmd_sweep(int argc, char **argv) {
                 return 2;
             }
             if (bad || !cb) {
-                fprintf(stderr, "cbvh sweep: --formats expects cbvh[,qbvh][,tlist[:options]...], got '%s'\n", v);
+                cbvh_sweep_formats_syntax(ferr, sizeof ferr);
+                fprintf(stderr, "cbvh sweep: --formats expects %s, got '%s'\n", ferr, v);
                 return 2;
             }
         } else if (strcmp(a, "--test-corrupt") == 0) {
@@ -767,10 +752,8 @@ int cmd_sweep(int argc, char **argv) {
             const cbvh_sweep_run_t *r = i < 0 ? &res.ref : i >= res.nrows ? &res.extra[i - res.nrows] : &res.rows[i];
             if (i < 0)
                 snprintf(name, sizeof name, "float");
-            else if (i >= res.nrows && o.extra[i - res.nrows].format == CBVH_FORMAT_QBVH)
-                snprintf(name, sizeof name, "qbvh M=%d", r->s.mant);
             else if (i >= res.nrows)
-                snprintf(name, sizeof name, "%s", o.extra[i - res.nrows].name);
+                cbvh_sweep_format_label(&o.extra[i - res.nrows], r->s.mant, name, sizeof name);
             else
                 snprintf(name, sizeof name, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
             const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
@@ -815,9 +798,7 @@ int cmd_sweep(int argc, char **argv) {
         if (res.all_same)
             printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
                    "false misses) and render the same %dx%d image\n",
-                   res.nrows, res.nextra == 1 && o.extra[0].format == CBVH_FORMAT_QBVH ? " and the QBVH"
-                              : res.nextra                                            ? " and the other formats"
-                                                                                      : "",
+                   res.nrows, cbvh_sweep_others(o.extra, res.nextra, name, sizeof name),
                    o.one_sided ? " (one-sided)" : "", (unsigned long long)res.ref_rays, res.width, res.height);
         else {
             for (int i = 0; i < res.nrows; i++)
@@ -833,11 +814,9 @@ int cmd_sweep(int argc, char **argv) {
     }
     if (first_bad >= res.nrows) {
         const cbvh_sweep_run_t *r = &res.extra[first_bad - res.nrows];
-        if (o.extra[first_bad - res.nrows].format == CBVH_FORMAT_QBVH)
-            fprintf(stderr, "cbvh sweep: qbvh M=%d differs from the float BVH: %s\n", r->s.mant, r->why);
-        else
-            fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", o.extra[first_bad - res.nrows].name,
-                    r->why);
+        char name[CBVH_FORMAT_NAME_MAX + 16];
+        cbvh_sweep_format_label(&o.extra[first_bad - res.nrows], r->s.mant, name, sizeof name);
+        fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", name, r->why);
     } else if (first_bad >= 0) {
         const cbvh_sweep_run_t *r = &res.rows[first_bad];
         fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits, r->s.mant,
