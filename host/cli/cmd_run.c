@@ -15,7 +15,6 @@
 #include <cjson/cJSON.h>
 
 #include "link/backend.h"
-#include "cbvh/oom.h"
 #include "cli/commands.h"
 #include "trace/effects.h"
 #include "trace/metrics.h"
@@ -184,12 +183,7 @@ int cmd_run(int argc, char **argv) {
             cJSON_AddNumberToObject(r, "cpu_us_per_ray", w->m.cpu_us);
             cJSON_AddItemToArray(arr, r);
         }
-        char *text = cJSON_Print(root);
-        if (!text) cbvh_out_of_memory("run JSON");
-        cbvh_json_fputs_utf8(text, stdout); /* paths may hold bytes that are not UTF-8 */
-        putchar('\n');
-        free(text);
-        cJSON_Delete(root);
+        cbvh_json_print(root, 1, "run JSON");
     } else {
         printf("\n== Accuracy vs time: %s (%u triangles, %llu rays over its effects) ==\n", scene_path,
                d.mesh.ntris, (unsigned long long)f->m.rays);

@@ -10,7 +10,6 @@
 
 #include <cjson/cJSON.h>
 
-#include "cbvh/oom.h"
 #include "cli/commands.h"
 #include "trace/effects.h"
 #include "trace/metrics.h"
@@ -289,12 +288,7 @@ static void write_json(const trace_opts *t, const cbvh_scene_desc *d, const cbvh
         json_result(root, t->fmt->name, d, rc, tp);
         cJSON_AddBoolToObject(root, "same_hits", same);
     }
-    char *text = cJSON_PrintUnformatted(root);
-    if (!text) cbvh_out_of_memory("trace JSON");
-    cbvh_json_fputs_utf8(text, stdout); /* paths may hold bytes that are not UTF-8 */
-    putchar('\n');
-    free(text);
-    cJSON_Delete(root);
+    cbvh_json_print(root, 0, "trace JSON");
 }
 
 static void write_table(const trace_opts *t, const cbvh_scene_desc *d, const cbvh_fx_result *rf,
@@ -307,7 +301,7 @@ static void write_table(const trace_opts *t, const cbvh_scene_desc *d, const cbv
            d->camera.height, spp_used);
     char desc[200];
     cbvh_format_params fp = {{t->bits, t->min_scale}, t->mant, t->one_sided};
-    t->fmt->describe(t->spec, &fp, desc, sizeof desc);
+    t->fmt->describe(&fp, desc, sizeof desc);
     printf("format %s: %s; %s memory %llu B", t->spec, desc, t->fmt->memory, (unsigned long long)main_r->node_bytes);
     if (rc)
         printf(" (float BVH %llu B, x%.3f)", (unsigned long long)rf->node_bytes,

@@ -69,6 +69,12 @@ static inline void cbvh_json_fputs_utf8(const char *s, FILE *f) {
     }
 }
 
+/* Prints a --json document to stdout (indented if pretty, else on one line)
+ * through cbvh_json_fputs_utf8, then a newline, and deletes it; out of
+ * memory is reported as `what` (cbvh/oom.h).  cli/json_print.c. */
+struct cJSON;
+void cbvh_json_print(struct cJSON *root, int pretty, const char *what);
+
 /* A JSON string literal of s: quotes, backslashes and control bytes escaped,
  * bytes outside well-formed UTF-8 as \u00XX. */
 static inline void cbvh_json_str(const char *s, FILE *f) {

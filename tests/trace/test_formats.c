@@ -277,7 +277,7 @@ static void hits_through_table(void) {
                 check_units(specs[k], f, &sum);
                 CHECK(f->bytes(state[k]) > 0, "%s: no bytes", specs[k]);
                 char desc[200] = "";
-                f->describe(specs[k], &in.p, desc, sizeof desc);
+                f->describe(&in.p, desc, sizeof desc);
                 CHECK(desc[0], "%s: no description", specs[k]);
                 if (phase == 1 && one_sided)
                     printf("%-20s %5d rays, %6d hits closest+any, %8llu box and %7llu triangle tests, %8llu B\n",

@@ -90,7 +90,7 @@ typedef struct cbvh_format {
      * with a one-line reason.  NULL: the spec is the name. */
     int (*parse)(const char *spec, char *canon, size_t n, char *err, size_t errlen);
     /* Its parameters in words: "N=6, M=24, min scale -30, modulo". */
-    void (*describe)(const char *spec, const cbvh_format_params *p, char *out, size_t n);
+    void (*describe)(const cbvh_format_params *p, char *out, size_t n);
     /* 0 with *state set, or -1 with a one-line reason (nothing to free). */
     int (*build)(const cbvh_format_input *in, void **state, cbvh_unit_activity *u, char *err, size_t errlen);
     /* The triangles moved (same count): update for them.  0 or -1 + reason. */
@@ -103,7 +103,7 @@ typedef struct cbvh_format {
     uint64_t (*bytes)(const void *state);
     /* The units its traversals ran, from the counters summed over them. */
     void (*units)(const cbvh_trav_stats *sum, cbvh_unit_activity *u);
-    void (*free)(void *state);
+    void (*free)(void *state); /* a state a build returned */
 } cbvh_format;
 
 /* The formats, in the order of the table (the reference first); n = how many. */

@@ -19,8 +19,7 @@ typedef struct {
     int mant;
 } state;
 
-static void describe(const char *spec, const cbvh_format_params *p, char *out, size_t n) {
-    (void)spec;
+static void describe(const cbvh_format_params *p, char *out, size_t n) {
     snprintf(out, n, "N=%d, M=%d, min scale %d, modulo", p->cbvh.quant_bits, p->mant, p->cbvh.min_scale);
 }
 
@@ -41,7 +40,6 @@ static int compress(state *s, const cbvh_tri *refit_tris, cbvh_unit_activity *u,
 
 static void release(void *st) {
     state *s = st;
-    if (!s) return;
     if (s->have_tree) cbvh_tree_free(&s->tree);
     cbvh_bvh_free(&s->bvh);
     free(s);
@@ -90,18 +88,7 @@ static void units(const cbvh_trav_stats *sum, cbvh_unit_activity *u) {
 }
 
 const cbvh_format cbvh_format_cbvh = {
-    .name = "cbvh",
-    .title = "CBVH",
-    .help = "cbvh: the CBVH against the float BVH (default)",
-    .memory = "node",
-    .build_note = "CBVH: SAH build + bottom-up streaming compression",
-    .refit_note = "",
+    .name = "cbvh", .title = "CBVH", .help = "cbvh: the CBVH against the float BVH (default)", .memory = "node",
+    .build_note = "CBVH: SAH build + bottom-up streaming compression", .refit_note = "",
     .flags = CBVH_FORMAT_USES_N | CBVH_FORMAT_USES_MANT,
-    .describe = describe,
-    .build = build,
-    .refit = refit,
-    .trace = trace,
-    .bytes = bytes,
-    .units = units,
-    .free = release,
-};
+    .describe = describe, .build = build, .refit = refit, .trace = trace, .bytes = bytes, .units = units, .free = release};

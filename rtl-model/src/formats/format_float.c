@@ -14,8 +14,7 @@ typedef struct {
     int mant;
 } state;
 
-static void describe(const char *spec, const cbvh_format_params *p, char *out, size_t n) {
-    (void)spec;
+static void describe(const cbvh_format_params *p, char *out, size_t n) {
     snprintf(out, n, "M=%d", p->mant);
 }
 
@@ -57,24 +56,11 @@ static void units(const cbvh_trav_stats *sum, cbvh_unit_activity *u) {
 
 static void release(void *st) {
     state *s = st;
-    if (!s) return;
     cbvh_bvh_free(&s->bvh);
     free(s);
 }
 
 const cbvh_format cbvh_format_float = {
-    .name = "float",
-    .title = "float BVH",
-    .help = "float: the float BVH only",
-    .memory = "node",
-    .build_note = "SAH build",
-    .refit_note = "",
-    .flags = CBVH_FORMAT_USES_MANT | CBVH_FORMAT_REFERENCE,
-    .describe = describe,
-    .build = build,
-    .refit = refit,
-    .trace = trace,
-    .bytes = bytes,
-    .units = units,
-    .free = release,
-};
+    .name = "float", .title = "float BVH", .help = "float: the float BVH only", .memory = "node",
+    .build_note = "SAH build", .refit_note = "", .flags = CBVH_FORMAT_USES_MANT | CBVH_FORMAT_REFERENCE,
+    .describe = describe, .build = build, .refit = refit, .trace = trace, .bytes = bytes, .units = units, .free = release};

@@ -15,8 +15,7 @@ typedef struct {
     int mant;
 } state;
 
-static void describe(const char *spec, const cbvh_format_params *p, char *out, size_t n) {
-    (void)spec;
+static void describe(const cbvh_format_params *p, char *out, size_t n) {
     snprintf(out, n, "4-ary, compressed 32-bit stack, M=%d", p->mant);
 }
 
@@ -72,24 +71,13 @@ static void units(const cbvh_trav_stats *sum, cbvh_unit_activity *u) {
 
 static void release(void *st) {
     state *s = st;
-    if (!s) return;
     cbvh_qbvh_free(&s->q);
     free(s);
 }
 
 const cbvh_format cbvh_format_qbvh = {
-    .name = "qbvh",
-    .title = "QBVH",
+    .name = "qbvh", .title = "QBVH", .memory = "node", .flags = CBVH_FORMAT_USES_MANT | CBVH_FORMAT_STACK_UNIT,
     .help = "qbvh: the QBVH (4-ary, compressed 32-bit stack, docs/qbvh.md) against it",
-    .memory = "node",
     .build_note = "QBVH: SAH build + 4-ary collapse",
     .refit_note = "; refits: the QBVH's own boxes bottom-up, topology kept",
-    .flags = CBVH_FORMAT_USES_MANT | CBVH_FORMAT_STACK_UNIT,
-    .describe = describe,
-    .build = build,
-    .refit = refit,
-    .trace = trace,
-    .bytes = bytes,
-    .units = units,
-    .free = release,
-};
+    .describe = describe, .build = build, .refit = refit, .trace = trace, .bytes = bytes, .units = units, .free = release};

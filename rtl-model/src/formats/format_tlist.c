@@ -93,8 +93,7 @@ static int parse(const char *spec, char *canon, size_t n, char *err, size_t errl
     return 0;
 }
 
-static void describe(const char *spec, const cbvh_format_params *p, char *out, size_t n) {
-    (void)spec;
+static void describe(const cbvh_format_params *p, char *out, size_t n) {
     (void)p;
     snprintf(out, n, "sphere hierarchy + lists");
 }
@@ -180,7 +179,6 @@ static int build_lists(state *s, char *err, size_t errlen) {
 
 static void release(void *st) {
     state *s = st;
-    if (!s) return;
     if (s->have_tl) {
         cbvh_tlists_free(&s->tl);
         cbvh_bsh_free(&s->bsh);
@@ -252,20 +250,8 @@ static void units(const cbvh_trav_stats *sum, cbvh_unit_activity *u) {
 }
 
 const cbvh_format cbvh_format_tlist = {
-    .name = "tlist",
-    .title = "traversal-list",
+    .name = "tlist", .title = "traversal-list", .memory = "list", .flags = CBVH_FORMAT_OPTIONS, .parse = parse,
     .help = "tlist[:1|2|6|8][:earliest|:latest][:cull][:heads]: traversal lists over a\n"
             "bounding-sphere hierarchy (docs/tlist.md; default 6 lists, earliest first)",
-    .memory = "list",
-    .build_note = "sphere hierarchy + lists",
-    .refit_note = ", rebuilt per frame",
-    .flags = CBVH_FORMAT_OPTIONS,
-    .parse = parse,
-    .describe = describe,
-    .build = build,
-    .refit = refit,
-    .trace = trace,
-    .bytes = bytes,
-    .units = units,
-    .free = release,
-};
+    .build_note = "sphere hierarchy + lists", .refit_note = ", rebuilt per frame",
+    .describe = describe, .build = build, .refit = refit, .trace = trace, .bytes = bytes, .units = units, .free = release};
