@@ -1,7 +1,7 @@
 /* Effects -> rays, traced with the units of the chosen format
- * (docs/scenes.md; the formats are behind cbvh/format.h).  Ray generation is host-side float math (it is not a
- * hardware unit); the traversal and every count come from the bit-exact
- * model. */
+ * (docs/scenes.md; the formats are behind cbvh/format.h).  Ray generation is
+ * host-side float math (it is not a hardware unit); the traversal and every
+ * count come from the bit-exact model. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include "trace/effects.h"
 
