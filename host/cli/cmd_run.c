@@ -15,9 +15,9 @@
 #include <cjson/cJSON.h>
 
 #include "link/backend.h"
-#include "cbvh/oom.h"
 #include "cli/commands.h"
 #include "trace/effects.h"
+#include "trace/metrics.h"
 #include "scene/scene_file.h"
 #include "trace/timing_model.h"
 #include "vectors/vectors_check.h"
@@ -48,8 +48,8 @@ static void usage(FILE *f) {
 
 typedef struct {
     int bits; /* 0 = float BVH */
-    uint64_t node_bytes, rays, hit_digest;
-    double box, tri, bytes, model_ns, cpu_us; /* per ray, all effects */
+    uint64_t node_bytes, hit_digest;
+    cbvh_ray_metrics m; /* per ray, all effects */
 } width_row;
 
 /* Traces the scene in one format and sums the per-effect counters. */
@@ -57,30 +57,21 @@ static int measure(const cbvh_scene_desc *d, const cbvh_timing_params *tp, int b
                    size_t errlen) {
     cbvh_fx_opts o;
     memset(&o, 0, sizeof o);
-    o.format = bits ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT;
+    o.format = bits ? "cbvh" : "float";
     o.params.quant_bits = bits ? bits : 6;
     o.params.min_scale = CBVH_MIN_SCALE_DEFAULT;
     o.mant = 24;
     cbvh_fx_result r;
     if (cbvh_fx_run(d, &o, &r, err, errlen) != 0) return -1;
     cbvh_fx_stats t = cbvh_fx_total(&r);
-    cbvh_timing_work w = {t.st.box_tests, t.st.tri_tests, t.st.nodes, t.st.bytes};
     memset(row, 0, sizeof *row);
     row->bits = bits;
-    row->rays = t.rays;
-    cbvh_timing_result tr;
-    if (cbvh_timing_eval(tp, &w, &tr) != 0 || row->rays == 0) {
+    if (cbvh_ray_metrics_of(&t, tp, &row->m) != 0 || row->m.rays == 0) {
         snprintf(err, errlen, "scene traces no rays or has an invalid timing model");
         return -1;
     }
-    double n = (double)row->rays;
     row->node_bytes = r.node_bytes;
     row->hit_digest = r.hit_digest;
-    row->box = (double)w.box_tests / n;
-    row->tri = (double)w.tri_tests / n;
-    row->bytes = (double)w.bytes / n;
-    row->model_ns = tr.seconds * 1e9 / n;
-    row->cpu_us = t.cpu_seconds * 1e6 / n;
     return 0;
 }
 
@@ -176,7 +167,7 @@ int cmd_run(int argc, char **argv) {
         cJSON *s = cJSON_AddObjectToObject(root, "scene");
         cJSON_AddStringToObject(s, "path", scene_path);
         cJSON_AddNumberToObject(s, "triangles", d.mesh.ntris);
-        cJSON_AddNumberToObject(s, "rays", (double)f->rays);
+        cJSON_AddNumberToObject(s, "rays", (double)f->m.rays);
         cJSON_AddBoolToObject(s, "hits_identical_to_float", same_hits);
         cJSON *arr = cJSON_AddArrayToObject(root, "formats");
         for (int i = 0; i < nrows; i++) {
@@ -185,22 +176,18 @@ int cmd_run(int argc, char **argv) {
             cJSON_AddStringToObject(r, "format", w->bits ? "cbvh" : "float");
             if (w->bits) cJSON_AddNumberToObject(r, "bits", w->bits);
             cJSON_AddNumberToObject(r, "node_bytes", (double)w->node_bytes);
-            cJSON_AddNumberToObject(r, "box_tests_per_ray", w->box);
-            cJSON_AddNumberToObject(r, "tri_tests_per_ray", w->tri);
-            cJSON_AddNumberToObject(r, "bytes_per_ray", w->bytes);
-            cJSON_AddNumberToObject(r, "model_ns_per_ray", w->model_ns);
-            cJSON_AddNumberToObject(r, "cpu_us_per_ray", w->cpu_us);
+            cJSON_AddNumberToObject(r, "box_tests_per_ray", w->m.box);
+            cJSON_AddNumberToObject(r, "tri_tests_per_ray", w->m.tri);
+            cJSON_AddNumberToObject(r, "bytes_per_ray", w->m.bytes);
+            cJSON_AddNumberToObject(r, "model_ns_per_ray", w->m.model_ns);
+            cJSON_AddNumberToObject(r, "cpu_us_per_ray", w->m.cpu_us);
             cJSON_AddItemToArray(arr, r);
         }
-        char *text = cJSON_Print(root);
-        if (!text) cbvh_out_of_memory("run JSON");
-        cbvh_json_fputs_utf8(text, stdout); /* paths may hold bytes that are not UTF-8 */
-        putchar('\n');
-        free(text);
+        cbvh_json_print_pretty(root, stdout); /* a write error is main's one line */
         cJSON_Delete(root);
     } else {
         printf("\n== Accuracy vs time: %s (%u triangles, %llu rays over its effects) ==\n", scene_path,
-               d.mesh.ntris, (unsigned long long)f->rays);
+               d.mesh.ntris, (unsigned long long)f->m.rays);
         printf("  format  memory  box/ray  tri/ray  bytes/ray  model ns/ray  CPU us/ray   (x float: memory, box, tri, "
                "bytes, model, CPU)\n");
         for (int i = 0; i < nrows; i++) {
@@ -208,15 +195,15 @@ int cmd_run(int argc, char **argv) {
             char name[16];
             snprintf(name, sizeof name, w->bits ? "N=%d" : "float", w->bits);
             printf("  %-6s %7llu  %7.2f  %7.2f  %9.0f  %12.1f  %10.2f", name, (unsigned long long)w->node_bytes,
-                   w->box, w->tri, w->bytes, w->model_ns, w->cpu_us);
+                   w->m.box, w->m.tri, w->m.bytes, w->m.model_ns, w->m.cpu_us);
             if (w->bits) {
                 printf("  ");
                 cbvh_print_x(cbvh_ratio((double)w->node_bytes, (double)f->node_bytes), 3);
-                cbvh_print_x(cbvh_ratio(w->box, f->box), 3);
-                cbvh_print_x(cbvh_ratio(w->tri, f->tri), 3);
-                cbvh_print_x(cbvh_ratio(w->bytes, f->bytes), 3);
-                cbvh_print_x(cbvh_ratio(w->model_ns, f->model_ns), 3);
-                cbvh_print_x(cbvh_ratio(w->cpu_us, f->cpu_us), 2);
+                cbvh_print_x(cbvh_ratio(w->m.box, f->m.box), 3);
+                cbvh_print_x(cbvh_ratio(w->m.tri, f->m.tri), 3);
+                cbvh_print_x(cbvh_ratio(w->m.bytes, f->m.bytes), 3);
+                cbvh_print_x(cbvh_ratio(w->m.model_ns, f->m.model_ns), 3);
+                cbvh_print_x(cbvh_ratio(w->m.cpu_us, f->m.cpu_us), 2);
             }
             printf("\n");
         }

@@ -142,31 +142,16 @@ typedef struct {
     int explicit_all;
 } heat_spec;
 
-/* A format name of --formats / --heatmap: "qbvh" or a tlist spec; the
- * canonical name goes to f.  0 or -1. */
-static int parse_format(const char *t, cbvh_sweep_format *f, char *err, size_t errlen) {
-    memset(f, 0, sizeof *f);
-    if (strcmp(t, "qbvh") == 0) {
-        f->format = CBVH_FORMAT_QBVH;
-        snprintf(f->name, sizeof f->name, "qbvh");
-        return 0;
-    }
-    if (cbvh_tlist_opts_parse(t, &f->tlist, err, errlen)) return -1;
-    f->format = CBVH_FORMAT_TLIST;
-    cbvh_tlist_opts_name(&f->tlist, f->name, sizeof f->name);
-    return 0;
-}
-
 static int parse_heat(const char *s, heat_spec *h) {
     memset(h, 0, sizeof *h);
     if (strcmp(s, "float") == 0) {
         h->is_float = 1;
         return 0;
     }
-    if (strcmp(s, "qbvh") == 0 || strncmp(s, "tlist", 5) == 0) {
+    if (cbvh_sweep_format_find(s)) {
         cbvh_sweep_format f;
         char e[160];
-        if (parse_format(s, &f, e, sizeof e)) return -1;
+        if (cbvh_sweep_format_parse(s, &f, e, sizeof e)) return -1;
         snprintf(h->fmt, sizeof h->fmt, "%s", f.name);
         return 0;
     }
@@ -375,8 +360,7 @@ static int parse_bits(const char *v, cbvh_sweep_opts *o) {
 
 /* A word --heatmap takes (else the next option or the scene). */
 static int is_heat_word(const char *a) {
-    return a[0] != '-' && (strcmp(a, "float") == 0 || strcmp(a, "qbvh") == 0 || strncmp(a, "tlist", 5) == 0 ||
-                           (a[0] >= '0' && a[0] <= '9'));
+    return a[0] != '-' && (strcmp(a, "float") == 0 || cbvh_sweep_format_find(a) || (a[0] >= '0' && a[0] <= '9'));
 }
 
 /* --heatmap's settings: first, then the following heat words. */
@@ -414,9 +398,9 @@ static int parse_formats(const char *v, cbvh_sweep_opts *o) {
             continue;
         }
         cbvh_sweep_format f;
-        if (strcmp(t, "qbvh") != 0 && strncmp(t, "tlist", 5) != 0)
+        if (!cbvh_sweep_format_find(t))
             bad = 1;
-        else if (parse_format(t, &f, ferr, sizeof ferr))
+        else if (cbvh_sweep_format_parse(t, &f, ferr, sizeof ferr))
             bad = 2;
         else if (o->nextra == CBVH_SWEEP_MAX_EXTRA) {
             snprintf(ferr, sizeof ferr, "at most %d formats besides cbvh", CBVH_SWEEP_MAX_EXTRA);
@@ -435,7 +419,8 @@ static int parse_formats(const char *v, cbvh_sweep_opts *o) {
         return -1;
     }
     if (bad || !cb) {
-        fprintf(stderr, "cbvh sweep: --formats expects cbvh[,qbvh][,tlist[:options]...], got '%s'\n", v);
+        cbvh_sweep_formats_syntax(ferr, sizeof ferr);
+        fprintf(stderr, "cbvh sweep: --formats expects %s, got '%s'\n", ferr, v);
         return -1;
     }
     return 0;
@@ -878,10 +863,8 @@ static const cbvh_sweep_run_t *row_named(const sweep_cli *c, const cbvh_sweep_re
     const cbvh_sweep_run_t *r = i < 0 ? &res->ref : i >= res->nrows ? &res->extra[i - res->nrows] : &res->rows[i];
     if (i < 0)
         snprintf(name, n, "float");
-    else if (i >= res->nrows && c->run.extra[i - res->nrows].format == CBVH_FORMAT_QBVH)
-        snprintf(name, n, "qbvh M=%d", r->s.mant);
     else if (i >= res->nrows)
-        snprintf(name, n, "%s", c->run.extra[i - res->nrows].name);
+        cbvh_sweep_format_label(&c->run.extra[i - res->nrows], r->s.mant, name, n);
     else
         snprintf(name, n, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
     return r;
@@ -945,12 +928,11 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
                 print_x(f->relv[(size_t)SWEEP_TRI * res->nrows + k * nb + b]);
                 printf("\n");
             }
+    char others[CBVH_FORMAT_NAME_MAX + 16];
     if (res->all_same)
         printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
                "false misses) and render the same %dx%d image\n",
-               res->nrows, res->nextra == 1 && c->run.extra[0].format == CBVH_FORMAT_QBVH ? " and the QBVH"
-                           : res->nextra                                               ? " and the other formats"
-                                                                                       : "",
+               res->nrows, cbvh_sweep_others(c->run.extra, res->nextra, others, sizeof others),
                c->run.one_sided ? " (one-sided)" : "", (unsigned long long)res->ref_rays, res->width, res->height);
     else {
         for (int i = 0; i < res->nrows; i++)
@@ -975,11 +957,11 @@ static int report(const sweep_cli *c, const sweep_figures *f, const sweep_files 
         if (i < res->nrows)
             fprintf(stderr, "cbvh sweep: setting N=%d M=%d E=%d differs from the float BVH: %s\n", r->s.bits,
                     r->s.mant, r->s.min_scale, r->why);
-        else if (c->run.extra[i - res->nrows].format == CBVH_FORMAT_QBVH)
-            fprintf(stderr, "cbvh sweep: qbvh M=%d differs from the float BVH: %s\n", r->s.mant, r->why);
-        else
-            fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", c->run.extra[i - res->nrows].name,
-                    r->why);
+        else {
+            char name[CBVH_FORMAT_NAME_MAX + 16];
+            cbvh_sweep_format_label(&c->run.extra[i - res->nrows], r->s.mant, name, sizeof name);
+            fprintf(stderr, "cbvh sweep: %s differs from the float BVH: %s\n", name, r->why);
+        }
         break;
     }
     if (w->nfailed)

@@ -1,11 +1,10 @@
 /* Effects -> rays, traced with the units of the chosen format
- * (docs/scenes.md).  Ray generation is host-side float math (it is not a
- * hardware unit); the traversal and every count come from the bit-exact
- * model. */
+ * (docs/scenes.md; the formats are behind cbvh/format.h).  Ray generation is
+ * host-side float math (it is not a hardware unit); the traversal and every
+ * count come from the bit-exact model. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime */
 #include "trace/effects.h"
 
-#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,21 +71,13 @@ static void cosine_dir(rng *r, const float n[3], float out[3]) {
     for (int i = 0; i < 3; i++) out[i] = x * t[i] + y * b[i] + z * n[i];
 }
 
-/* ---- the accelerator: float BVH, CBVH, QBVH or traversal lists ---- */
+/* ---- the tracer: the chosen format's state and the frame being traced ---- */
 typedef struct {
     const cbvh_scene_desc *d;
     const cbvh_fx_opts *o;
     cbvh_fx_result *res;
-    cbvh_bvh bvh;
-    cbvh_tree tree;
-    int have_tree;
-    cbvh_qbvh qbvh;
-    int have_qbvh;
-    cbvh_bsh bsh;
-    cbvh_tlists tl;
-    int have_tl;
-    uint32_t *cell_head; /* pinhole primary rays: per screen cell, per list */
-    int cell_w, cell_h;  /* cell size in pixels */
+    const cbvh_format *F;
+    void *state;    /* the format's */
     cbvh_tri *tris; /* current frame */
     float eps;      /* secondary-ray origin offset along the normal */
     int frame;
@@ -123,19 +114,6 @@ static double ray_clock_overhead(void) {
     return overhead;
 }
 
-/* Where a ray starts in list l (docs/tlist.md §7): a camera ray of a pinhole
- * camera at its screen cell's head; a secondary ray at its source triangle's
- * head when it leaves on the front side; else the list's start. */
-static uint32_t tlist_head(const tracer *T, const cbvh_ray *r, int l, uint32_t src) {
-    const cbvh_tlists *L = &T->tl;
-    if (src == UINT32_MAX) {
-        if (!T->cell_head) return 0;
-        int cx = T->px / T->cell_w, cy = T->py / T->cell_h, ncx = (T->d->camera.width + T->cell_w - 1) / T->cell_w;
-        return T->cell_head[((size_t)cy * (size_t)ncx + (size_t)cx) * CBVH_TLIST_MAX + (size_t)l];
-    }
-    return T->o->tlist.poly_heads ? cbvh_tlist_poly_head(L, l, src, T->tris, r) : 0;
-}
-
 static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3], const float dir[3], float tmax,
                  uint32_t src, int light, cbvh_trav_hit *hit) {
     cbvh_ray r;
@@ -148,45 +126,12 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
     cbvh_trav_stats st = {0};
     /* One-sided scenes: the same rule on every format (the reference included). */
     cbvh_trav_mode tm = T->o->one_sided ? (cbvh_trav_mode)(mode | CBVH_TRAV_FRONT_ONLY) : mode;
+    cbvh_format_from from = {src, T->px, T->py};
     double clk = ray_clock_overhead(), t0 = ray_clock();
-    int rc;
-    if (T->o->format == CBVH_FORMAT_TLIST) {
-        int l = cbvh_tlist_pick(&T->tl, &r);
-        rc = cbvh_trace_tlist(&T->tl, l, tlist_head(T, &r, l, src), T->tris, &r, tm, hit, &st);
-    } else
-        rc = T->o->format == CBVH_FORMAT_CBVH ? cbvh_trace_cbvh(&T->tree, T->tris, &r, T->o->mant, tm, hit, &st)
-             : T->o->format == CBVH_FORMAT_QBVH
-                 ? cbvh_trace_qbvh(&T->qbvh, T->tris, &r, T->o->mant, tm, CBVH_QSTACK_COMPRESSED, hit, &st)
-                 : cbvh_trace_bvh(&T->bvh, T->tris, &r, T->o->mant, tm, hit, &st);
+    int rc = T->F->trace(T->state, T->tris, &r, tm, &from, hit, &st);
     double dt = ray_clock() - t0 - clk;
-    cbvh_fx_stats *s = &T->res->fx[fx];
-    s->cpu_seconds += dt > 0 ? dt : 0;
-    s->rays++;
-    if (mode & CBVH_TRAV_ANY)
-        s->any++;
-    else
-        s->closest++;
-    if (rc) {
-        s->rejected++;
-        memset(hit, 0, sizeof *hit);
-    }
-    s->hits += hit->hit != 0;
-    s->st.nodes += st.nodes;
-    s->st.box_tests += st.box_tests;
-    s->st.tri_tests += st.tri_tests;
-    s->st.lines += st.lines;
-    s->st.bytes += st.bytes;
-    if (st.max_stack > s->st.max_stack) s->st.max_stack = st.max_stack;
-    s->st.qstack_pushes += st.qstack_pushes;
-    s->st.qstack_pops += st.qstack_pops;
-    cbvh_unit_activity *u = &T->res->units;
-    if (T->o->format == CBVH_FORMAT_TLIST)
-        u->ray_sphere += st.box_tests; /* the lists' "box tests" are sphere tests */
-    else
-        u->ray_box += st.box_tests;
-    u->ray_triangle += st.tri_tests;
-    if (T->o->format == CBVH_FORMAT_CBVH) u->decoder += 6 * st.nodes;
-    u->qbvh_stack += st.qstack_pushes + st.qstack_pops;
+    if (rc) memset(hit, 0, sizeof *hit);
+    cbvh_fx_stats_add_ray(&T->res->fx[fx], mode, rc, hit->hit, &st, dt > 0 ? dt : 0);
     /* Closest hit: triangle and t are defined (same on every format); any hit: only whether. */
     uint64_t h = T->res->hit_digest ^
                  (!hit->hit ? 0xFFFFFFFFFFFFFFFFu : (mode & CBVH_TRAV_ANY) ? 1 : ((uint64_t)hit->prim << 32 | hit->t));
@@ -273,8 +218,10 @@ static void camera_frame(const cbvh_camera *c, float w[3], float u[3], float v[3
 }
 
 /* The pinhole direction through image point (px, py) in [0, 1]^2 (the
- * formula of camera_ray). */
-static void pinhole_dir(const cbvh_camera *c, float px, float py, float dir[3]) {
+ * formula of camera_ray) of camera cam (a cbvh_camera; the signature of
+ * cbvh_format_pinhole.dir). */
+static void pinhole_dir(const void *cam, float px, float py, float dir[3]) {
+    const cbvh_camera *c = cam;
     float w[3], u[3], v[3];
     camera_frame(c, w, u, v);
     float th = tanf(0.5f * c->fov * PI_F / 180.0f), aspect = (float)c->width / (float)c->height;
@@ -340,207 +287,15 @@ static void trace_frame(tracer *T) {
     }
 }
 
-static int compress(tracer *T, const cbvh_tri *refit, char *err, size_t errlen) {
-    cbvh_compress_opts co = {T->o->params, CBVH_ENC_MODULO, 1, 0};
-    cbvh_tree nt;
-    cbvh_bu_stats bs;
-    if (cbvh_compress_bottomup(&T->bvh, refit, &co, &nt, &bs, err, errlen)) return -1;
-    if (T->have_tree) cbvh_tree_free(&T->tree);
-    T->tree = nt;
-    T->have_tree = 1;
-    T->res->units.compressor += 6 * (bs.encodes + bs.reencodes) + 3;
-    return 0;
-}
-
-/* Refit of the QBVH's own boxes, keeping its topology: nodes are laid out
- * breadth-first (children after their parent), so one pass from the last
- * node to the root sees every child before its parent.  Returns the number
- * of node boxes recomputed. */
-static uint64_t qbvh_refit(cbvh_qbvh *q, const cbvh_tri *tris) {
-    for (uint32_t i = q->nnodes; i-- > 0;) {
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        uint32_t c = q->count[i], f = q->first[i];
-        if (c & CBVH_QBVH_LEAF) {
-            for (uint32_t k = 0; k < (c & ~CBVH_QBVH_LEAF); k++)
-                for (int v = 0; v < 3; v++)
-                    for (int a = 0; a < 3; a++) {
-                        float x = tris[q->prims[f + k]].v[v][a];
-                        lo[a] = fminf(lo[a], x);
-                        hi[a] = fmaxf(hi[a], x);
-                    }
-        } else
-            for (uint32_t k = 0; k < c; k++)
-                for (int a = 0; a < 3; a++) {
-                    lo[a] = fminf(lo[a], q->bmin[f + k][a]);
-                    hi[a] = fmaxf(hi[a], q->bmax[f + k][a]);
-                }
-        for (int a = 0; a < 3; a++) {
-            q->bmin[i][a] = lo[a];
-            q->bmax[i][a] = hi[a];
-        }
-    }
-    return q->nnodes;
-}
-
-/* The refit relies on children lying after their parent (breadth-first). */
-static int qbvh_children_after_parent(const cbvh_qbvh *q) {
-    for (uint32_t i = 0; i < q->nnodes; i++)
-        if (!(q->count[i] & CBVH_QBVH_LEAF) && q->first[i] <= i) return 0;
-    return 1;
-}
-
-const char *cbvh_format_name(cbvh_accel_format f) {
-    return f == CBVH_FORMAT_CBVH ? "cbvh" : f == CBVH_FORMAT_QBVH ? "qbvh" : f == CBVH_FORMAT_TLIST ? "tlist" : "float";
-}
-
-int cbvh_tlist_opts_parse(const char *s, cbvh_tlist_opts *t, char *err, size_t errlen) {
-    memset(t, 0, sizeof *t);
-    t->p.nlists = 6;
-    t->p.order = CBVH_TLIST_EARLIEST_FIRST;
-    char buf[128];
-    if (strncmp(s, "tlist", 5) != 0 || (s[5] && s[5] != ':') || strlen(s) >= sizeof buf) {
-        snprintf(err, errlen, "format '%s': expected tlist[:1|2|6|8][:earliest|:latest][:cull][:heads]", s);
-        return -1;
-    }
-    snprintf(buf, sizeof buf, "%s", s + 5);
-    /* Split on ':' by hand: callers may be inside their own strtok loop.  Each
-     * group (count, order, cull, heads) at most once: "tlist:6:2" would
-     * otherwise silently mean 2. */
-    int seen[4] = {0, 0, 0, 0};
-    for (char *k = buf[0] ? buf + 1 : NULL, *next; k; k = next) {
-        next = strchr(k, ':');
-        if (next) *next++ = 0;
-        int group = isdigit((unsigned char)k[0]) ? 0 : strcmp(k, "earliest") == 0 || strcmp(k, "latest") == 0 ? 1
-                    : strcmp(k, "cull") == 0                                                             ? 2
-                    : strcmp(k, "heads") == 0                                                            ? 3
-                                                                                                           : -1;
-        if (group >= 0 && seen[group]++) {
-            static const char *const what[4] = {"a list count", "an order", "cull", "heads"};
-            snprintf(err, errlen, "format '%s': %s given twice", s, what[group]);
-            return -1;
-        }
-        if (strcmp(k, "1") == 0 || strcmp(k, "2") == 0 || strcmp(k, "6") == 0 || strcmp(k, "8") == 0)
-            t->p.nlists = k[0] - '0';
-        else if (strcmp(k, "earliest") == 0)
-            t->p.order = CBVH_TLIST_EARLIEST_FIRST;
-        else if (strcmp(k, "latest") == 0)
-            t->p.order = CBVH_TLIST_LATEST_LAST;
-        else if (strcmp(k, "cull") == 0)
-            t->p.cull_back = 1;
-        else if (strcmp(k, "heads") == 0)
-            t->poly_heads = t->cell_heads = 1;
-        else {
-            snprintf(err, errlen, "format '%s': unknown tlist option '%s' (lists 1|2|6|8, earliest|latest, cull, heads)",
-                     s, k);
-            return -1;
-        }
-    }
-    return 0;
-}
-
-void cbvh_tlist_opts_name(const cbvh_tlist_opts *t, char *out, size_t n) {
-    snprintf(out, n, "tlist:%d:%s%s%s", t->p.nlists ? t->p.nlists : 6,
-             t->p.order == CBVH_TLIST_LATEST_LAST ? "latest" : "earliest", t->p.cull_back ? ":cull" : "",
-             t->poly_heads || t->cell_heads ? ":heads" : "");
-}
-
-/* Per-screen-cell heads for a pinhole camera: the image split into at most
- * 16 x 16 cells, each cell's primary rays bounded by the cone of its four
- * corner directions (widened by 2^-16 rad for the float rounding of pixel
- * directions). */
-static int build_cell_heads(tracer *T, char *err, size_t errlen) {
-    const cbvh_camera *c = &T->d->camera;
-    free(T->cell_head);
-    T->cell_head = NULL;
-    if (!T->o->tlist.cell_heads || c->type != CBVH_CAM_PINHOLE) return 0;
-    T->cell_w = (c->width + 15) / 16;
-    T->cell_h = (c->height + 15) / 16;
-    int ncx = (c->width + T->cell_w - 1) / T->cell_w, ncy = (c->height + T->cell_h - 1) / T->cell_h;
-    T->cell_head = calloc((size_t)ncx * (size_t)ncy * CBVH_TLIST_MAX, sizeof *T->cell_head);
-    if (!T->cell_head) cbvh_out_of_memory("tile lists");
-    for (int cy = 0; cy < ncy; cy++)
-        for (int cx = 0; cx < ncx; cx++) {
-            int x0 = cx * T->cell_w, y0 = cy * T->cell_h;
-            int x1 = x0 + T->cell_w < c->width ? x0 + T->cell_w : c->width;
-            int y1 = y0 + T->cell_h < c->height ? y0 + T->cell_h : c->height;
-            float corner[4][3];
-            const float X[4] = {(float)x0, (float)x1, (float)x1, (float)x0}, Y[4] = {(float)y0, (float)y0, (float)y1, (float)y1};
-            for (int k = 0; k < 4; k++) pinhole_dir(c, X[k] / (float)c->width, Y[k] / (float)c->height, corner[k]);
-            if (cbvh_tlist_cell_heads(&T->tl, T->tris, c->position, corner, 0x1p-16,
-                                      &T->cell_head[((size_t)cy * (size_t)ncx + (size_t)cx) * CBVH_TLIST_MAX])) {
-                snprintf(err, errlen, "tlist: cannot compute the screen-cell heads (non-finite camera)");
-                return -1;
-            }
-        }
-    return 0;
-}
-
-/* (Re)builds the sphere hierarchy and the lists for the current frame. */
-static int build_tlists(tracer *T, char *err, size_t errlen) {
-    if (T->have_tl) {
-        cbvh_tlists_free(&T->tl);
-        cbvh_bsh_free(&T->bsh);
-        T->have_tl = 0;
-    }
-    cbvh_scene sc = T->d->mesh;
-    sc.tris = T->tris;
-    sc.nmorph = 0;
-    sc.nkeys = 0;
-    int nlists = T->o->tlist.p.nlists ? T->o->tlist.p.nlists : 6;
-    /* Per-polygon heads cost about 2-10 us per triangle and list to
-     * precompute; past this size that is many minutes: refuse up front. */
-    if (T->o->tlist.poly_heads && (uint64_t)sc.ntris * (uint64_t)nlists > CBVH_FX_POLY_HEADS_MAX) {
-        snprintf(err, errlen,
-                 "tlist: per-polygon heads for %u triangles x %d lists exceed the limit of %llu (minutes of "
-                 "precomputation); drop ':heads' or use fewer lists",
-                 sc.ntris, nlists, (unsigned long long)CBVH_FX_POLY_HEADS_MAX);
-        return -1;
-    }
-    cbvh_bsh_params bp;
-    cbvh_bsh_default_params(&bp);
-    if (cbvh_bsh_build(&sc, &bp, &T->bsh, err, errlen)) return -1;
-    cbvh_tlist_params lp = T->o->tlist.p;
-    lp.nlists = nlists;
-    if (cbvh_tlists_build(&T->bsh, &sc, &lp, &T->tl, err, errlen)) {
-        cbvh_bsh_free(&T->bsh);
-        return -1;
-    }
-    T->have_tl = 1;
-    if (T->o->tlist.poly_heads) {
-        /* Secondary rays start at q = hit point + eps n: the margin covers eps
-         * and the hit point's rounding (docs/tlist.md §7.1). */
-        const cbvh_camera *c = &T->d->camera;
-        float cmax = 0;
-        for (uint32_t i = 0; i < sc.ntris; i++)
-            for (int v = 0; v < 3; v++)
-                for (int a = 0; a < 3; a++) cmax = fmaxf(cmax, fabsf(sc.tris[i].v[v][a]));
-        cmax += T->eps;
-        for (int a = 0; a < 3; a++) cmax = fmaxf(cmax, fabsf(c->position[a]) + fabsf(c->aperture));
-        float margin = cbvh_tlist_hitpoint_margin(T->eps, cmax);
-        if (!isfinite(margin)) { /* coordinates near FLT_MAX: no binary32 margin covers the hit points */
-            snprintf(err, errlen,
-                     "tlist heads: coordinates up to %g leave no finite margin for the per-polygon heads "
-                     "(docs/tlist.md 7.1); trace without :heads",
-                     (double)cmax);
-            return -1;
-        }
-        if (cbvh_tlists_poly_heads(&T->tl, T->tris, CBVH_TLIST_HEADS_REGULAR, margin, err, errlen)) return -1;
-    }
-    return build_cell_heads(T, err, errlen);
-}
-
 int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result *r, char *err, size_t errlen) {
     memset(r, 0, sizeof *r);
     if (o->mant < CBVH_MANT_MIN || o->mant > CBVH_MANT_MAX) {
         snprintf(err, errlen, "--mant %d out of range %d..%d", o->mant, CBVH_MANT_MIN, CBVH_MANT_MAX);
         return -1;
     }
-    if (o->format == CBVH_FORMAT_CBVH && cbvh_params_check(&o->params)) {
-        snprintf(err, errlen, "bad CBVH parameters N=%d min_scale=%d (N in %d..%d, min_scale in -126..126)",
-                 o->params.quant_bits, o->params.min_scale, CBVH_N_MIN, CBVH_N_MAX);
-        return -1;
-    }
     tracer T = {.d = d, .o = o, .res = r};
+    char spec[CBVH_FORMAT_NAME_MAX];
+    if (cbvh_format_parse(o->format ? o->format : "float", &T.F, spec, sizeof spec, err, errlen)) return -1;
     r->frames = cbvh_scene_desc_frames(d);
     r->ntris = d->mesh.ntris;
     T.tris = malloc((size_t)d->mesh.ntris * sizeof *T.tris);
@@ -553,36 +308,26 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     float dg[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     T.eps = 1e-4f * sqrtf(dot3(dg, dg));
     if (!(T.eps > 0)) T.eps = 1e-6f;
+    /* What the rays will be: camera rays from within the lens around the
+     * position; a pinhole camera's through the formula of camera_ray. */
+    const cbvh_camera *c = &d->camera;
+    cbvh_format_pinhole pin = {c->width, c->height, {c->position[0], c->position[1], c->position[2]}, pinhole_dir, c};
+    cbvh_format_input in = {.spec = spec,
+                            .p = {o->params, o->mant, o->one_sided},
+                            .scene = &frame0,
+                            .eps = T.eps,
+                            .pinhole = c->type == CBVH_CAM_PINHOLE ? &pin : NULL};
+    for (int a = 0; a < 3; a++) in.origin_max = fmaxf(in.origin_max, fabsf(c->position[a]) + fabsf(c->aperture));
     int rc = -1;
     double b0 = cpu_now();
-    if (o->format != CBVH_FORMAT_TLIST && cbvh_build_sah(&frame0, 0, 0, &T.bvh, err, errlen)) {
+    if (T.F->build(&in, &T.state, &r->units, err, errlen)) {
         free(T.tris);
         return -1;
     }
-    if (o->format == CBVH_FORMAT_CBVH) {
-        if (compress(&T, NULL, err, errlen)) goto out;
-        r->node_bytes = cbvh_tree_bytes(&T.tree);
-    } else if (o->format == CBVH_FORMAT_QBVH) {
-        if (cbvh_qbvh_from_bvh(&T.bvh, &T.qbvh, err, errlen)) goto out;
-        T.have_qbvh = 1;
-        if (cbvh_qbvh_stack_check(&T.qbvh, CBVH_QSTACK_COMPRESSED, err, errlen)) goto out;
-        if (!qbvh_children_after_parent(&T.qbvh)) {
-            snprintf(err, errlen, "qbvh: a child group lies before its parent (layout not breadth-first)");
-            goto out;
-        }
-        r->node_bytes = cbvh_qbvh_node_bytes(&T.qbvh) + (uint64_t)T.qbvh.nprims * 4u;
-    } else if (o->format == CBVH_FORMAT_TLIST) {
-        if (o->tlist.p.cull_back && !o->one_sided) {
-            snprintf(err, errlen, "tlist: back-face culling needs one-sided triangles (--one-sided)");
-            goto out;
-        }
-        if (build_tlists(&T, err, errlen)) goto out;
-        r->node_bytes = cbvh_tlists_bytes(&T.tl);
-    } else
-        r->node_bytes = cbvh_bvh_bytes(&T.bvh);
+    r->node_bytes = T.F->bytes(T.state);
     r->build_cpu_seconds = cpu_now() - b0;
-    size_t npx = (size_t)d->camera.width * (size_t)d->camera.height;
-    if (d->camera.type == CBVH_CAM_FISHEYE) { /* only a fisheye leaves pixels without a ray */
+    size_t npx = (size_t)c->width * (size_t)c->height;
+    if (c->type == CBVH_CAM_FISHEYE) { /* only a fisheye leaves pixels without a ray */
         T.had_ray = calloc(npx, 1);
         if (!T.had_ray) cbvh_out_of_memory("fisheye pixel map");
     }
@@ -591,58 +336,26 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
             /* Animation: move the vertices and refit (never for a static scene). */
             cbvh_scene_desc_frame(d, T.frame, T.tris);
             double t0 = cpu_now();
-            if (o->format == CBVH_FORMAT_CBVH) {
-                if (compress(&T, T.tris, err, errlen)) goto out; /* streaming refit */
-                r->units.refit += T.bvh.nnodes;
-            } else if (o->format == CBVH_FORMAT_QBVH)
-                r->units.refit += qbvh_refit(&T.qbvh, T.tris); /* the QBVH's boxes, same topology */
-            else if (o->format == CBVH_FORMAT_TLIST) {
-                if (build_tlists(&T, err, errlen)) goto out; /* lists are not updatable: rebuilt */
-                r->units.refit += T.bsh.nnodes;
-            } else {
-                cbvh_bvh_refit(&T.bvh, T.tris);
-                r->units.refit += T.bvh.nnodes;
-            }
+            if (T.F->refit(T.state, T.tris, &r->units, err, errlen)) goto out;
             r->build_cpu_seconds += cpu_now() - t0;
             r->refits++;
         }
         trace_frame(&T);
     }
     for (size_t p = 0; T.had_ray && p < npx; p++) r->pixels_without_ray += !T.had_ray[p];
+    cbvh_fx_stats total = cbvh_fx_total(r);
+    T.F->units(&total.st, &r->units); /* the units the traversals ran */
     rc = 0;
 out:
     free(T.had_ray);
-    if (T.have_tree) cbvh_tree_free(&T.tree);
-    if (T.have_qbvh) cbvh_qbvh_free(&T.qbvh);
-    if (T.have_tl) {
-        cbvh_tlists_free(&T.tl);
-        cbvh_bsh_free(&T.bsh);
-    }
-    free(T.cell_head);
-    cbvh_bvh_free(&T.bvh);
+    T.F->free(T.state);
     free(T.tris);
     return rc;
 }
 
 cbvh_fx_stats cbvh_fx_total(const cbvh_fx_result *r) {
     cbvh_fx_stats t = {0};
-    for (int e = 0; e < CBVH_FX_COUNT; e++) {
-        const cbvh_fx_stats *s = &r->fx[e];
-        t.rays += s->rays;
-        t.closest += s->closest;
-        t.any += s->any;
-        t.hits += s->hits;
-        t.rejected += s->rejected;
-        t.st.nodes += s->st.nodes;
-        t.st.box_tests += s->st.box_tests;
-        t.st.tri_tests += s->st.tri_tests;
-        t.st.lines += s->st.lines;
-        t.st.bytes += s->st.bytes;
-        if (s->st.max_stack > t.st.max_stack) t.st.max_stack = s->st.max_stack;
-        t.st.qstack_pushes += s->st.qstack_pushes;
-        t.st.qstack_pops += s->st.qstack_pops;
-        t.cpu_seconds += s->cpu_seconds;
-    }
+    for (int e = 0; e < CBVH_FX_COUNT; e++) cbvh_fx_stats_add(&t, &r->fx[e]);
     return t;
 }
 

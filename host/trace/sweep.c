@@ -117,8 +117,7 @@ static void on_progress(void *vctx, int frame, int frames, int row, int rows) {
     if (c->o->progress) c->o->progress(c->o->ctx, c->label, c->setting + 1, c->nsettings, row, rows);
 }
 
-static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, const cbvh_tlist_opts *tl, char *err,
-                   size_t errlen) {
+static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char *err, size_t errlen) {
     size_t npx = (size_t)c->d->camera.width * (size_t)c->d->camera.height;
     run->box_px = xcalloc(npx, sizeof *run->box_px);
     run->image = xcalloc(npx, 1);
@@ -126,14 +125,13 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, c
     c->run = run;
     c->n = 0;
     run->same = 1;
-    cbvh_fx_opts fo = {.format = fmt,
+    cbvh_fx_opts fo = {.format = format,
                        .params = {run->s.bits ? run->s.bits : 6, run->s.min_scale},
                        .mant = run->s.mant,
                        .spp = c->o->spp,
                        .on_ray = on_ray,
                        .progress = on_progress,
                        .ctx = c};
-    if (tl) fo.tlist = *tl;
     fo.one_sided = c->o->one_sided;
     int rc = cbvh_fx_run(c->d, &fo, &run->r, err, errlen);
     for (size_t p = 0; p < npx; p++) {
@@ -211,7 +209,7 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
                    .spp = res->spp};
     int rc = -1;
     res->ref.s = (cbvh_sweep_setting){0, CBVH_MANT_MAX, o->min_scale[0]};
-    if (run_one(&c, &res->ref, CBVH_FORMAT_FLOAT, NULL, err, errlen)) goto out;
+    if (run_one(&c, &res->ref, "float", err, errlen)) goto out;
     res->ref_rays = c.nrec;
     if (o->corrupt_setting >= 0 && o->corrupt_ray >= c.nrec) { /* a fault that never fires would pass */
         snprintf(err, errlen, "--test-corrupt %d:%llu: no ray %llu, the sweep traces rays 0..%llu", o->corrupt_setting,
@@ -226,7 +224,7 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
         snprintf(label, sizeof label, "N=%d M=%d E=%d", run->s.bits, run->s.mant, run->s.min_scale);
         c.setting = i;
         c.label = label;
-        if (run_one(&c, run, CBVH_FORMAT_CBVH, NULL, err, errlen)) goto out;
+        if (run_one(&c, run, "cbvh", err, errlen)) goto out;
         check_totals(&c, run, res);
     }
     for (int k = 0; k < o->nextra; k++) {
@@ -234,13 +232,10 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
         cbvh_sweep_run_t *run = &res->extra[k];
         res->nextra = k + 1;
         run->s = (cbvh_sweep_setting){0, o->mant[0], o->min_scale[0]};
-        if (f->format == CBVH_FORMAT_QBVH)
-            snprintf(label, sizeof label, "%s M=%d", f->name, run->s.mant);
-        else
-            snprintf(label, sizeof label, "%s", f->name);
+        cbvh_sweep_format_label(f, run->s.mant, label, sizeof label);
         c.setting = res->nrows + k;
         c.label = label;
-        if (run_one(&c, run, f->format, &f->tlist, err, errlen)) goto out;
+        if (run_one(&c, run, f->name, err, errlen)) goto out;
         check_totals(&c, run, res);
     }
     rc = 0;
@@ -267,16 +262,53 @@ void cbvh_sweep_free(cbvh_sweep_result *res) {
 }
 
 void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, double out[SWEEP_NMETRICS]) {
-    for (int i = 0; i < SWEEP_NMETRICS; i++) out[i] = 0;
-    if (!s->rays) return;
-    double n = (double)s->rays;
-    out[SWEEP_BOX] = (double)s->st.box_tests / n;
-    out[SWEEP_TRI] = (double)s->st.tri_tests / n;
-    out[SWEEP_BYTES] = (double)s->st.bytes / n;
-    cbvh_timing_work w = {s->st.box_tests, s->st.tri_tests, s->st.nodes, s->st.bytes};
-    cbvh_timing_result tr;
-    if (cbvh_timing_eval(tp, &w, &tr) == 0) out[SWEEP_MODEL_NS] = tr.seconds * 1e9 / n;
-    out[SWEEP_CPU_US] = s->cpu_seconds * 1e6 / n;
+    cbvh_ray_metrics m;
+    cbvh_ray_metrics_of(s, tp, &m);
+    out[SWEEP_BOX] = m.box;
+    out[SWEEP_TRI] = m.tri;
+    out[SWEEP_BYTES] = m.bytes;
+    out[SWEEP_MODEL_NS] = m.model_ns;
+    out[SWEEP_CPU_US] = m.cpu_us;
+}
+
+const cbvh_format *cbvh_sweep_format_find(const char *spec) {
+    const cbvh_format *f = cbvh_format_find(spec);
+    return f && !(f->flags & (CBVH_FORMAT_REFERENCE | CBVH_FORMAT_USES_N)) ? f : NULL;
+}
+
+int cbvh_sweep_format_parse(const char *spec, cbvh_sweep_format *f, char *err, size_t errlen) {
+    memset(f, 0, sizeof *f);
+    if (!cbvh_sweep_format_find(spec)) {
+        char syntax[200];
+        cbvh_sweep_formats_syntax(syntax, sizeof syntax);
+        snprintf(err, errlen, "format '%s': expected one of %s", spec, syntax);
+        return -1;
+    }
+    return cbvh_format_parse(spec, &f->ops, f->name, sizeof f->name, err, errlen);
+}
+
+void cbvh_sweep_formats_syntax(char *out, size_t n) {
+    size_t nf, used = (size_t)snprintf(out, n, "cbvh");
+    const cbvh_format *const *fmts = cbvh_formats(&nf);
+    for (size_t i = 0; i < nf && used < n; i++)
+        if (cbvh_sweep_format_find(fmts[i]->name))
+            used += (size_t)snprintf(out + used, n - used, "[,%s%s]", fmts[i]->name,
+                                     fmts[i]->flags & CBVH_FORMAT_OPTIONS ? "[:options]..." : "");
+}
+
+void cbvh_sweep_format_label(const cbvh_sweep_format *f, int mant, char *out, size_t n) {
+    if (f->ops->flags & CBVH_FORMAT_USES_MANT)
+        snprintf(out, n, "%s M=%d", f->name, mant);
+    else
+        snprintf(out, n, "%s", f->name);
+}
+
+const char *cbvh_sweep_others(const cbvh_sweep_format *extra, int nextra, char *buf, size_t n) {
+    if (nextra == 1 && !(extra[0].ops->flags & CBVH_FORMAT_OPTIONS))
+        snprintf(buf, n, " and the %s", extra[0].ops->title);
+    else
+        snprintf(buf, n, "%s", nextra ? " and the other formats" : "");
+    return buf;
 }
 
 int cbvh_sweep_knee(const int *bits, const double *rel, int n, double tol) {

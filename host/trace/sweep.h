@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cbvh/format.h"
 #include "trace/effects.h"
 #include "scene/scene_file.h"
 #include "trace/timing_model.h"
@@ -20,12 +21,28 @@
 #define CBVH_SWEEP_MAX_LIST 16 /* values of --mant and of --min-scale */
 #define CBVH_SWEEP_MAX_EXTRA 12 /* other formats (--formats) */
 
-/* One more format traced after the CBVH settings, at the first M. */
+/* One more format traced after the CBVH settings, at the first M: any
+ * format of the table (cbvh/format.h) but the float BVH (the reference) and
+ * the CBVH (the swept one, the format with N). */
 typedef struct {
-    cbvh_accel_format format; /* CBVH_FORMAT_QBVH or CBVH_FORMAT_TLIST */
-    cbvh_tlist_opts tlist;    /* format tlist */
-    char name[48];            /* "qbvh", "tlist:6:earliest:cull:heads", ... */
+    const cbvh_format *ops;
+    char name[CBVH_FORMAT_NAME_MAX]; /* canonical: "qbvh", "tlist:6:earliest:cull:heads", ... */
 } cbvh_sweep_format;
+
+/* The other format a word of --formats or --heatmap names (its name, or its
+ * name and options: cbvh_format_find), or NULL. */
+const cbvh_format *cbvh_sweep_format_find(const char *spec);
+/* cbvh_sweep_format_find and the format's options into *f: 0, or -1 with a
+ * one-line reason. */
+int cbvh_sweep_format_parse(const char *spec, cbvh_sweep_format *f, char *err, size_t errlen);
+/* The syntax of --formats for messages: "cbvh[,qbvh][,tlist[:options]...]". */
+void cbvh_sweep_formats_syntax(char *out, size_t n);
+/* A format's label in rows and messages: its name, and " M=24" for a format
+ * whose boxes go through the M-bit ray-box unit. */
+void cbvh_sweep_format_label(const cbvh_sweep_format *f, int mant, char *out, size_t n);
+/* How the hits line names the other formats: "" (none), " and the QBVH"
+ * (one, without options: its title), " and the other formats". */
+const char *cbvh_sweep_others(const cbvh_sweep_format *extra, int nextra, char *buf, size_t n);
 
 typedef struct {
     int bits; /* N; 0 = the float BVH */
@@ -81,7 +98,8 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
                    size_t errlen);
 void cbvh_sweep_free(cbvh_sweep_result *res);
 
-/* Per-ray costs of a set of rays. */
+/* Per-ray costs of a set of rays (cbvh_ray_metrics_of) indexed for the
+ * sweep's loops over costs. */
 enum { SWEEP_BOX = 0, SWEEP_TRI, SWEEP_BYTES, SWEEP_MODEL_NS, SWEEP_CPU_US, SWEEP_NMETRICS };
 void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, double out[SWEEP_NMETRICS]);
 

@@ -31,30 +31,17 @@ void cbvh_json_fputs_utf8(const char *s, FILE *f) {
     }
 }
 
-void cbvh_json_str(const char *s, FILE *f) {
-    const unsigned char *p = (const unsigned char *)s;
-    fputc('"', f);
-    while (*p) {
-        int n = cbvh_utf8_len(p);
-        if (*p == '"' || *p == '\\')
-            fprintf(f, "\\%c", *p);
-        else if (*p < 0x20 || !n)
-            fprintf(f, "\\u%04x", *p);
-        else
-            fwrite(p, 1, (size_t)n, f);
-        p += n ? n : 1;
-    }
-    fputc('"', f);
-}
-
-int cbvh_json_print(const cJSON *root, FILE *f) {
-    char *txt = cJSON_PrintUnformatted(root);
+static int json_write(const cJSON *root, FILE *f, int pretty) {
+    char *txt = pretty ? cJSON_Print(root) : cJSON_PrintUnformatted(root);
     if (!txt) cbvh_out_of_memory("JSON output");
     cbvh_json_fputs_utf8(txt, f); /* file names may hold bytes that are not UTF-8 */
     fputc('\n', f);
     free(txt);
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }
+
+int cbvh_json_print(const cJSON *root, FILE *f) { return json_write(root, f, 0); }
+int cbvh_json_print_pretty(const cJSON *root, FILE *f) { return json_write(root, f, 1); }
 
 size_t cbvh_json_find_nul(const char *text, size_t len) {
     /* Outside strings a backslash is not JSON at all (the parser refuses it),

@@ -22,15 +22,13 @@ int cbvh_utf8_len(const unsigned char *s);
  * well-formed UTF-8 as \u00XX.  Such bytes can only sit inside strings. */
 void cbvh_json_fputs_utf8(const char *s, FILE *f);
 
-/* A JSON string literal of s: quotes, backslashes and control bytes escaped,
- * bytes outside well-formed UTF-8 as \u00XX. */
-void cbvh_json_str(const char *s, FILE *f);
-
 /* The --json writer: root as one line of compact JSON and a newline on f,
  * bytes outside UTF-8 as above.  0, or -1 when f reports a write error (the
  * caller's one line; for stdout, main's).  Out of memory is
  * cbvh_out_of_memory. */
 int cbvh_json_print(const cJSON *root, FILE *f);
+/* The same, indented (cJSON_Print), for `cbvh run --json`. */
+int cbvh_json_print_pretty(const cJSON *root, FILE *f);
 
 /* The offset in text (len bytes of JSON) of the first NUL, a raw byte or a
  * \u0000 escape inside a string, or len if none.  cJSON keeps it in the

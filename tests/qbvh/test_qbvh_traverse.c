@@ -2,7 +2,8 @@
  * scenes, for every ray the QBVH closest hit (triangle, t, b1, b2 bits) equals
  * the binary float BVH's, any-hit agrees, the three stack kinds visit the same
  * nodes, and the compressed stack is never deeper than the binary one.  Also:
- * the 2^26 limit on a sparse tree (compressed: clear error; wide: correct). */
+ * the 2^26 limit on a sparse tree (compressed: clear error; wide: correct);
+ * the refit of the QBVH's own boxes. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,6 +75,76 @@ static void run_scene(const char *spec, int nrays) {
            (double)sb.nodes / nrays, (double)sq[1].nodes / nrays, (double)sb.box_tests / nrays,
            (double)sq[1].box_tests / nrays, (double)sb.tri_tests / nrays, (double)sq[1].tri_tests / nrays, hits,
            nrays);
+    cbvh_qbvh_free(&q);
+    cbvh_bvh_free(&b);
+    cbvh_scene_free(&s);
+}
+
+/* Refit (cbvh_qbvh_refit, docs/qbvh.md §3): with the triangles the QBVH was
+ * built from it gives back every box bit for bit (the collapse keeps the
+ * binary BVH's tight boxes); with moved triangles (a twist) its boxes enclose
+ * them again (cbvh_qbvh_check) and its closest hits equal those of the binary
+ * BVH refitted to them (cbvh_bvh_refit), ray by ray; it recomputes every
+ * node.  A child group before its parent is refused up front. */
+static void refit(const char *spec, int nrays) {
+    cbvh_scene s = {0};
+    char err[256];
+    if (cbvh_scene_open(spec, &s, err, sizeof err)) {
+        CHECK(0, "%s: %s", spec, err);
+        return;
+    }
+    cbvh_bvh b = {0};
+    cbvh_qbvh q = {0};
+    CHECK(cbvh_build_sah(&s, 0, 0, &b, err, sizeof err) == 0, "sah: %s", err);
+    CHECK(cbvh_qbvh_from_bvh(&b, &q, err, sizeof err) == 0, "collapse: %s", err);
+    CHECK(cbvh_qbvh_refit_check(&q, err, sizeof err) == 0, "refit check: %s", err);
+    size_t box_bytes = (size_t)q.nnodes * sizeof *q.bmin;
+    float(*bmin0)[4] = malloc(box_bytes), (*bmax0)[4] = malloc(box_bytes);
+    cbvh_tri *moved = malloc((size_t)s.ntris * sizeof *moved);
+    if (!bmin0 || !bmax0 || !moved) {
+        CHECK(0, "cannot allocate");
+        goto out;
+    }
+    memcpy(bmin0, q.bmin, box_bytes);
+    memcpy(bmax0, q.bmax, box_bytes);
+    CHECK(cbvh_qbvh_refit(&q, s.tris) == q.nnodes, "refit: not every node recomputed");
+    CHECK(memcmp(bmin0, q.bmin, box_bytes) == 0 && memcmp(bmax0, q.bmax, box_bytes) == 0,
+          "%s: refit to the same triangles changed a box", spec);
+    cbvh_scene_deform(&s, 0.8f, 0.1f, 1.0f, moved);
+    cbvh_scene ms = s;
+    ms.tris = moved;
+    CHECK(cbvh_qbvh_refit(&q, moved) == q.nnodes, "refit: not every node recomputed");
+    CHECK(memcmp(bmin0, q.bmin, box_bytes) != 0, "%s: the twist moved no box", spec);
+    CHECK(cbvh_qbvh_check(&q, &ms, err, sizeof err) == 0, "%s: refitted QBVH: %s", spec, err);
+    cbvh_bvh_refit(&b, moved);
+    float lo[3], hi[3];
+    cbvh_scene_bounds(&ms, lo, hi);
+    int hits = 0;
+    for (int i = 0; i < nrays; i++) {
+        cbvh_ray r = box_ray(&rs, lo, hi, i, 0);
+        cbvh_trav_hit hb, hq;
+        cbvh_trav_stats st = {0};
+        CHECK(cbvh_trace_bvh(&b, moved, &r, 24, CBVH_TRAV_CLOSEST, &hb, &st) == 0, "bvh ray %d", i);
+        CHECK(cbvh_trace_qbvh(&q, moved, &r, 24, CBVH_TRAV_CLOSEST, CBVH_QSTACK_COMPRESSED, &hq, &st) == 0,
+              "qbvh ray %d", i);
+        CHECK(same_hit(&hb, &hq), "%s refitted, ray %d: bvh hit %d prim %u, qbvh hit %d prim %u", spec, i, hb.hit,
+              hb.prim, hq.hit, hq.prim);
+        hits += hb.hit;
+    }
+    CHECK(hits > nrays / 10, "%s refitted: only %d hits of %d rays", spec, hits, nrays);
+    /* A child group before its parent: the one pass would use stale boxes. */
+    if (q.nnodes > 1 && !(q.count[0] & CBVH_QBVH_LEAF)) {
+        uint32_t f0 = q.first[0];
+        q.first[0] = 0;
+        CHECK(cbvh_qbvh_refit_check(&q, err, sizeof err) == -1 && strstr(err, "before its parent"),
+              "a child group before its parent not refused");
+        q.first[0] = f0;
+    }
+    printf("%-22s refit: %u QBVH nodes, %d hits of %d rays after a twist\n", spec, q.nnodes, hits, nrays);
+out:
+    free(bmin0);
+    free(bmax0);
+    free(moved);
     cbvh_qbvh_free(&q);
     cbvh_bvh_free(&b);
     cbvh_scene_free(&s);
@@ -385,6 +456,8 @@ int main(void) {
     run_scene(CBVH_SCENES_DIR "/bunny-small.obj", n);
     run_scene("proc:cloth:48", n);
     run_scene("proc:far", n / 2);
+    refit(CBVH_SCENES_DIR "/bunny-small.obj", n / 4);
+    refit("proc:cloth:48", n / 4);
     past_limit();
     cyclic();
     collapse_ties();

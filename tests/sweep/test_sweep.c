@@ -178,7 +178,7 @@ static void test_corrupted_anyhit_fails(void **state) {
 static void qbvh_run(int corrupt, uint64_t ray, cbvh_sweep_result *out) {
     cbvh_sweep_opts o = {.bits_lo = 6, .bits_hi = 6, .mant = {24}, .nmant = 1, .min_scale = {-30},
                          .nmin_scale = 1, .nextra = 1, .corrupt_setting = corrupt, .corrupt_ray = ray};
-    o.extra[0] = (cbvh_sweep_format){.format = CBVH_FORMAT_QBVH, .name = "qbvh"};
+    o.extra[0] = (cbvh_sweep_format){.ops = cbvh_format_find("qbvh"), .name = "qbvh"};
     char err[256];
     assert_int_equal(cbvh_sweep_run(&scene, &o, out, err, sizeof err), 0);
     assert_int_equal(out->nrows, 1);

@@ -20,6 +20,7 @@
 
 #include <cmocka.h>
 
+#include "cbvh/qbvh.h"
 #include "trace/effects.h"
 #include "scene/scene_file.h"
 #include "trace/timing_model.h"
@@ -35,7 +36,7 @@ static void load(const char *json, cbvh_scene_desc *d) {
     assert_int_equal(rc, 0);
 }
 
-static cbvh_fx_opts opts(cbvh_accel_format f) {
+static cbvh_fx_opts opts(const char *f) {
     cbvh_fx_opts o = {.format = f, .params = {6, CBVH_MIN_SCALE_DEFAULT}, .mant = 24};
     return o;
 }
@@ -127,7 +128,7 @@ static void primary_only(void **state) {
          ", \"lights\": [{\"type\": \"point\", \"position\": [8, 16, 10]}], \"effects\": [\"primary\"]}",
          &d);
     for (int f = 0; f < 2; f++) {
-        cbvh_fx_opts o = opts(f ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT);
+        cbvh_fx_opts o = opts(f ? "cbvh" : "float");
         watch w = {&d, {0}, 0};
         o.on_ray = on_ray;
         o.ctx = &w;
@@ -166,7 +167,7 @@ static void all_effects(void **state) {
     load(all_fx_scene, &d);
     cbvh_fx_result r[2];
     for (int f = 0; f < 2; f++) {
-        cbvh_fx_opts o = opts(f ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT);
+        cbvh_fx_opts o = opts(f ? "cbvh" : "float");
         watch w = {&d, {0}, 0};
         o.on_ray = on_ray;
         o.ctx = &w;
@@ -189,7 +190,7 @@ static void all_effects(void **state) {
     /* Soft shadows: 3 samples per area light per lit point, so a multiple of 3. */
     assert_int_equal(r[1].fx[CBVH_FX_SOFT_SHADOWS].rays % 3, 0);
     /* Deterministic: the same run gives the same digest. */
-    cbvh_fx_opts o = opts(CBVH_FORMAT_CBVH);
+    cbvh_fx_opts o = opts("cbvh");
     cbvh_fx_result again;
     run(&d, &o, &again);
     assert_int_equal(again.hit_digest, r[1].hit_digest);
@@ -201,7 +202,7 @@ static void no_mirror_material(void **state) {
     (void)state;
     cbvh_scene_desc d;
     load("{\"mesh\": \"" MESH "\", " CAMERA ", \"floor\": {}, \"effects\": [\"primary\", \"mirror\"]}", &d);
-    cbvh_fx_opts o = opts(CBVH_FORMAT_CBVH);
+    cbvh_fx_opts o = opts("cbvh");
     cbvh_fx_result r;
     run(&d, &o, &r);
     assert_true(r.fx[CBVH_FX_PRIMARY].hits > 0);
@@ -218,7 +219,7 @@ static void animated_refits(void **state) {
          "\"animation\": {\"type\": \"twist\", \"frames\": 3, \"amount\": 0.8}}",
          &d);
     for (int f = 0; f < 2; f++) {
-        cbvh_fx_opts o = opts(f ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT);
+        cbvh_fx_opts o = opts(f ? "cbvh" : "float");
         cbvh_fx_result r;
         run(&d, &o, &r);
         assert_int_equal(r.frames, 3);
@@ -260,7 +261,7 @@ static void record(void *ctx, const cbvh_fx_ray *r) {
     c->rec[c->n++] = closest && r->hit->hit ? r->hit->t : 0;
 }
 
-static void run_recorded(const cbvh_scene_desc *d, cbvh_accel_format f, recorder *c, cbvh_fx_result *r) {
+static void run_recorded(const cbvh_scene_desc *d, const char *f, recorder *c, cbvh_fx_result *r) {
     memset(c, 0, sizeof *c);
     c->w.d = d;
     cbvh_fx_opts o = opts(f);
@@ -280,7 +281,7 @@ static void qbvh_all_effects(void **state) {
     load(all_fx_scene, &d);
     static cbvh_fx_result r[3];
     recorder c[3];
-    const cbvh_accel_format fm[3] = {CBVH_FORMAT_FLOAT, CBVH_FORMAT_CBVH, CBVH_FORMAT_QBVH};
+    const char *const fm[3] = {"float", "cbvh", "qbvh"};
     for (int f = 0; f < 3; f++) run_recorded(&d, fm[f], &c[f], &r[f]);
     assert_int_equal(c[2].n, c[0].n);
     assert_memory_equal(c[2].rec, c[0].rec, c[0].n * sizeof *c[0].rec);
@@ -316,7 +317,7 @@ static void qbvh_effects_obeyed(void **state) {
          &d);
     cbvh_fx_result r;
     recorder c;
-    run_recorded(&d, CBVH_FORMAT_QBVH, &c, &r);
+    run_recorded(&d, "qbvh", &c, &r);
     assert_int_equal(r.fx[CBVH_FX_PRIMARY].rays, 24 * 18);
     assert_true(r.fx[CBVH_FX_HARD_SHADOWS].rays > 0);
     assert_int_equal(r.fx[CBVH_FX_HARD_SHADOWS].closest, 0);
@@ -344,8 +345,8 @@ static void qbvh_animated(void **state) {
          &d);
     static cbvh_fx_result r[2];
     recorder c[2];
-    run_recorded(&d, CBVH_FORMAT_FLOAT, &c[0], &r[0]);
-    run_recorded(&d, CBVH_FORMAT_QBVH, &c[1], &r[1]);
+    run_recorded(&d, "float", &c[0], &r[0]);
+    run_recorded(&d, "qbvh", &c[1], &r[1]);
     assert_int_equal(r[1].refits, 2);
     uint64_t nnodes = (r[1].node_bytes - (uint64_t)d.mesh.ntris * 4u) / CBVH_QBVH_NODE_BYTES;
     assert_int_equal(r[1].units.refit, 2 * nnodes);
@@ -381,15 +382,14 @@ static void tlist_all_effects(void **state) {
     for (int one_sided = 0; one_sided < 2; one_sided++) {
         static cbvh_fx_result rf, rl;
         recorder cf, cl;
-        cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
+        cbvh_fx_opts o = opts("float");
         o.one_sided = one_sided;
         run_recorded_o(&d, &o, &cf, &rf);
         for (size_t k = 0; k < sizeof specs / sizeof specs[0]; k++) {
             char err[256];
-            o = opts(CBVH_FORMAT_TLIST);
+            o = opts(specs[k]);
             o.one_sided = one_sided;
-            assert_int_equal(cbvh_tlist_opts_parse(specs[k], &o.tlist, err, sizeof err), 0);
-            if (o.tlist.p.cull_back && !one_sided) {
+            if (strstr(specs[k], ":cull") && !one_sided) {
                 cbvh_fx_result bad;
                 assert_int_equal(cbvh_fx_run(&d, &o, &bad, err, sizeof err), -1);
                 assert_non_null(strstr(err, "--one-sided"));
@@ -425,9 +425,7 @@ static void tlist_heads_save_work(void **state) {
     load(all_fx_scene, &d);
     cbvh_fx_result r[2];
     for (int h = 0; h < 2; h++) {
-        cbvh_fx_opts o = opts(CBVH_FORMAT_TLIST);
-        char err[256];
-        assert_int_equal(cbvh_tlist_opts_parse(h ? "tlist:6:heads" : "tlist:6", &o.tlist, err, sizeof err), 0);
+        cbvh_fx_opts o = opts(h ? "tlist:6:heads" : "tlist:6");
         run(&d, &o, &r[h]);
     }
     assert_int_equal(r[1].hit_digest, r[0].hit_digest);
@@ -450,13 +448,11 @@ static void tlist_animated(void **state) {
          &d);
     static cbvh_fx_result r[2];
     recorder c[2];
-    cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
+    cbvh_fx_opts o = opts("float");
     o.one_sided = 1;
     run_recorded_o(&d, &o, &c[0], &r[0]);
-    o = opts(CBVH_FORMAT_TLIST);
+    o = opts("tlist:6:cull:heads");
     o.one_sided = 1;
-    char err[256];
-    assert_int_equal(cbvh_tlist_opts_parse("tlist:6:cull:heads", &o.tlist, err, sizeof err), 0);
     run_recorded_o(&d, &o, &c[1], &r[1]);
     assert_int_equal(r[1].refits, 2);
     assert_true(r[1].units.refit > 0);
@@ -467,31 +463,42 @@ static void tlist_animated(void **state) {
     cbvh_scene_desc_free(&d);
 }
 
-/* The option parser: defaults, canonical names, one-line errors. */
+/* The option parser (through the format table): defaults, canonical names,
+ * one-line errors; a bad spec fails the run with the same line. */
 static void tlist_options(void **state) {
     (void)state;
-    cbvh_tlist_opts t;
-    char err[256], name[64];
-    assert_int_equal(cbvh_tlist_opts_parse("tlist", &t, err, sizeof err), 0);
-    cbvh_tlist_opts_name(&t, name, sizeof name);
+    const cbvh_format *f;
+    char err[256], name[CBVH_FORMAT_NAME_MAX];
+    assert_int_equal(cbvh_format_parse("tlist", &f, name, sizeof name, err, sizeof err), 0);
+    assert_string_equal(f->name, "tlist");
     assert_string_equal(name, "tlist:6:earliest");
-    assert_int_equal(cbvh_tlist_opts_parse("tlist:heads:8:cull:latest", &t, err, sizeof err), 0);
-    cbvh_tlist_opts_name(&t, name, sizeof name);
+    assert_int_equal(cbvh_format_parse("tlist:heads:8:cull:latest", &f, name, sizeof name, err, sizeof err), 0);
     assert_string_equal(name, "tlist:8:latest:cull:heads");
-    assert_true(t.poly_heads && t.cell_heads && t.p.cull_back && t.p.nlists == 8 && t.p.order == CBVH_TLIST_LATEST_LAST);
-    assert_int_equal(cbvh_tlist_opts_parse("tlist:4", &t, err, sizeof err), -1);
+    assert_int_equal(cbvh_format_parse("tlist:4", &f, name, sizeof name, err, sizeof err), -1);
     assert_non_null(strstr(err, "unknown tlist option '4'"));
-    assert_int_equal(cbvh_tlist_opts_parse("tlistx", &t, err, sizeof err), -1);
-    assert_int_equal(cbvh_tlist_opts_parse("tlist:", &t, err, sizeof err), -1);
+    assert_int_equal(cbvh_format_parse("tlistx", &f, name, sizeof name, err, sizeof err), -1);
+    assert_non_null(strstr(err, "format 'tlistx': expected tlist[:1|2|6|8]"));
+    assert_int_equal(cbvh_format_parse("tlist:", &f, name, sizeof name, err, sizeof err), -1);
     /* each option group once: the last one would otherwise win silently */
     static const char *const twice[][2] = {{"tlist:6:2", "a list count given twice"},
                                            {"tlist:earliest:latest", "an order given twice"},
                                            {"tlist:cull:8:cull", "cull given twice"},
                                            {"tlist:heads:heads", "heads given twice"}};
     for (int i = 0; i < 4; i++) {
-        assert_int_equal(cbvh_tlist_opts_parse(twice[i][0], &t, err, sizeof err), -1);
+        assert_int_equal(cbvh_format_parse(twice[i][0], &f, name, sizeof name, err, sizeof err), -1);
         if (!strstr(err, twice[i][1]) || strchr(err, '\n')) fail_msg("%s: '%s'", twice[i][0], err);
     }
+    /* the run refuses the same spec with the same line */
+    cbvh_scene_desc d;
+    load("{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"]}", &d);
+    cbvh_fx_opts o = opts("tlist:earliest:latest");
+    cbvh_fx_result r;
+    assert_int_equal(cbvh_fx_run(&d, &o, &r, err, sizeof err), -1);
+    assert_string_equal(err, "format 'tlist:earliest:latest': an order given twice");
+    o = opts("obvh");
+    assert_int_equal(cbvh_fx_run(&d, &o, &r, err, sizeof err), -1);
+    assert_string_equal(err, "format 'obvh': expected float, cbvh, qbvh or tlist[:options]");
+    cbvh_scene_desc_free(&d);
 }
 
 /* Cameras: fisheye leaves the corners without rays; thin lens shoots spp
@@ -502,7 +509,7 @@ static void cameras(void **state) {
     load("{\"mesh\": \"" MESH "\", \"camera\": {\"type\": \"fisheye\", \"width\": 20, \"height\": 20,"
          "\"position\": [0, 5, 9], \"target\": [0, 4.2, 0]}, \"effects\": [\"primary\"]}",
          &d);
-    cbvh_fx_opts o = opts(CBVH_FORMAT_FLOAT);
+    cbvh_fx_opts o = opts("float");
     cbvh_fx_result r;
     run(&d, &o, &r);
     assert_true(r.samples_without_ray > 0);

@@ -78,6 +78,16 @@ int cbvh_qbvh_check(const cbvh_qbvh *q, const cbvh_scene *s, char *err, size_t e
 /* Bytes of the node arrays (CBVH_QBVH_NODE_BYTES per node). */
 size_t cbvh_qbvh_node_bytes(const cbvh_qbvh *q);
 
+/* ---- refit (rtl-model/src/qbvh/refit_qbvh.c) -------------------------------
+ * The QBVH's own boxes recomputed bottom-up for moved vertices (same triangle
+ * count), topology kept: no re-collapse.  One pass from the last node to the
+ * root, which sees every child before its parent because children lie after
+ * their parent (breadth-first, as cbvh_qbvh_from_bvh lays them out; checked
+ * once by cbvh_qbvh_refit_check: 0, or -1 + reason).  Returns the number of
+ * node boxes recomputed (every node). */
+int cbvh_qbvh_refit_check(const cbvh_qbvh *q, char *err, size_t errlen);
+uint64_t cbvh_qbvh_refit(cbvh_qbvh *q, const cbvh_tri *tris);
+
 /* ---- traversal (rtl-model/src/qbvh/traverse_qbvh.c) ---------------------------- */
 typedef enum {
     CBVH_QSTACK_AUTO = 0,       /* compressed 32-bit if the tree fits 2^26, else wide */
