@@ -18,7 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -33,7 +32,7 @@ static int fails;
 
 static const char *busy = "busy: another host is connected";
 static const char *cbvh, *vec_file;
-static char dir[256], sock_path[300], addr[320], spec[330], out_path[300], err_path[300];
+static char dir[256], sock_path[300], addr[320], spec[330], out_path[300], err_path[300], board_out[300];
 
 static long now_ms(void) {
     struct timespec ts;
@@ -80,20 +79,20 @@ static int count_lines(const char *s) {
 }
 
 /* `cbvh board-sim --listen ADDR [extra]` in the background; its pid once it
- * listens, or -1. */
+ * says it listens (the socket file alone appears before listen()), or -1. */
 static pid_t board_start(const char *extra_opt, const char *extra_val) {
     unlink(sock_path);
+    unlink(board_out);
     pid_t pid = fork();
     if (pid == 0) {
-        int null = open("/dev/null", O_WRONLY);
-        if (null >= 0) dup2(null, 1);
+        int o = open(board_out, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+        if (o < 0 || dup2(o, 1) < 0) _exit(127);
         execl(cbvh, cbvh, "board-sim", "--listen", addr, extra_opt, extra_val, (char *)NULL);
         _exit(127);
     }
     for (int i = 0; i < 250; i++) {
-        struct stat st;
         int status;
-        if (stat(sock_path, &st) == 0 && S_ISSOCK(st.st_mode)) return pid;
+        if (strstr(slurp(board_out), "listening on")) return pid;
         if (waitpid(pid, &status, WNOHANG) == pid) {
             CHECK(0, "board-sim %s %s exited with %d before listening", extra_opt ? extra_opt : "",
                   extra_val ? extra_val : "", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
@@ -264,6 +263,7 @@ int main(int argc, char **argv) {
     snprintf(spec, sizeof spec, "sim:%s", addr);
     snprintf(out_path, sizeof out_path, "%s/out", dir);
     snprintf(err_path, sizeof err_path, "%s/err", dir);
+    snprintf(board_out, sizeof board_out, "%s/board.out", dir);
 
     unit = cbvh_unit_find("axis_compress");
     unit->layout(&cfg, &lay);
@@ -285,6 +285,7 @@ int main(int argc, char **argv) {
     unlink(sock_path);
     unlink(out_path);
     unlink(err_path);
+    unlink(board_out);
     rmdir(dir);
     if (fails) fprintf(stderr, "%d failures\n", fails);
     else printf("board-sim: a second host is refused at once, a silent one let go after --host-idle-ms\n");
