@@ -173,6 +173,7 @@ static void test_device_descriptor(void **s) {
     uint8_t b[256];
     assert_int_equal(ctl(0x80, 6, 0x0100, 0, 8, b), 8); /* first 8 bytes, as Linux asks */
     assert_int_equal(ctl(0x80, 6, 0x0100, 0, 255, b), 18);
+    assert_int_equal(ctl(0x80, 6, 0x0100, 0, 0, b), 0); /* wLength 0: no data stage, status IN */
     static const uint8_t want[18] = {18, 1, 0x00, 0x02, 0, 0, 0, 64, 0x09, 0x12, 0xB1, 0xC0, 0x10, 0x00, 1, 2, 3, 1};
     assert_memory_equal(b, want, 18);
 }

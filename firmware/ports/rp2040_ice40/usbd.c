@@ -73,6 +73,10 @@ static void ctl_send_next(usbd_dev *d) {
 
 /* Replies with data[0..len), cut to what the host asked for (wlength). */
 static void ctl_reply(usbd_dev *d, const uint8_t *data, size_t len, uint16_t wlength) {
+    if (wlength == 0) { /* no data stage: the status stage is ours (USB 2.0, 8.5.3) */
+        ctl_status_in(d);
+        return;
+    }
     if (len > wlength) len = wlength;
     d->ctl_data = data;
     d->ctl_left = (uint16_t)len;
