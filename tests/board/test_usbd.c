@@ -408,7 +408,7 @@ static void host_out_hid(const uint8_t *data, size_t n) {
 }
 
 static size_t request(uint8_t *buf, uint8_t cmd, uint16_t seq, const uint8_t *payload, uint16_t len) {
-    memcpy(buf + CBVH_FRAME_HDR, payload, len);
+    if (len) memcpy(buf + CBVH_FRAME_HDR, payload, len);
     return cbvh_frame_seal(buf, cmd, 0, seq, len);
 }
 

@@ -321,6 +321,7 @@ class Fpga {
     const t = this.tx;
     if (!t) { this.strayBytes = (this.strayBytes || 0) + 1; return 0xff; }
     if (!this.live) { this.regBytesWhileDead++; return 0xff; }
+    this.spiBytes = (this.spiBytes || 0) + 1;
     t.bytes.push(b);
     const i = t.bytes.length - 1;
     if (t.bytes[0] === 0x80) {
@@ -752,6 +753,25 @@ async function checkMode(opts, board, runner) {
       check(f.status === 0 && Buffer.compare(Buffer.from(f.payload), Buffer.from(payload)) === 0,
         `LOOPBACK of 4096 bytes over ${link}`);
     }
+    // RP2040 time per vector: a RUN of 100 scale_estimate vectors (N 6, min
+    // scale -30), its shape read from the register map first
+    board.regmap.write(0x00c, 6 | ((-30 & 0xffff) << 8));
+    board.regmap.write(0x010, 1);
+    const shape = board.regmap.read(0x014);
+    const nIn = shape & 0xff;
+    const nOut = (shape >> 8) & 0xff;
+    const count = 100;
+    const run = new Uint8Array(12 + 4 * nIn * count);
+    run.set([1, 6, 0xe2, 0xff, 0, nIn, nOut, 0, count, 0, 0, 0]);
+    for (let i = 12; i < run.length; i += 4) run[i] = i & 0x7f;
+    const spi0 = board.fpga.spiBytes;
+    const t0 = board.mcu.clock.nanos;
+    const f = await transact(runner, board, 'bulk', frame(3, 40, run), 5000);
+    const us = (board.mcu.clock.nanos - t0) / 1000 / count;
+    const spiPer = (board.fpga.spiBytes - spi0) / count;
+    check(f.status === 0 && f.payload.length === 4 + 4 * nOut * count,
+      `RUN of ${count} scale_estimate vectors over bulk: ${us.toFixed(0)} us of RP2040 time per vector, ` +
+      `${spiPer.toFixed(0)} SPI bytes per vector (emulated cycles; no SPI or USB wire time)`);
     check(board.fpga.minCsGapNs >= 333, `register-map CS high at least ${(board.fpga.minCsGapNs / 1000).toFixed(2)} us between transactions (4 FPGA clocks: 0.33 us)`);
     check(board.fpga.cutShort === 0, `${board.fpga.transactions} register transactions, none cut short`);
   }
@@ -920,6 +940,7 @@ async function serveMode(opts, board, runner, regmap) {
     stats.simulatedMs = board.mcu.clock.nanos / 1e6;
     stats.realMs = Date.now() - stats.started;
     stats.transactions = board.fpga.transactions;
+    stats.spiBytes = board.fpga.spiBytes || 0;
     try {
       if (opts.stats) fs.writeFileSync(opts.stats, JSON.stringify(stats, null, 1) + '\n');
     } catch (e) {

@@ -61,12 +61,13 @@ static uint8_t *slurp(const char *path, size_t *len) {
 
 static int spill(const char *path, const uint8_t *p, size_t n) {
     FILE *f = fopen(path, "wb");
-    if (!f || fwrite(p, 1, n, f) != n || fclose(f) != 0) {
-        fprintf(stderr, "%s: cannot write %s: %s\n", me, path, strerror(errno));
-        if (f) fclose(f);
-        return 1;
+    int ok = f != NULL;
+    if (f) {
+        ok = fwrite(p, 1, n, f) == n;
+        ok = fclose(f) == 0 && ok;
     }
-    return 0;
+    if (!ok) fprintf(stderr, "%s: cannot write %s: %s\n", me, path, strerror(errno));
+    return !ok;
 }
 
 static uint32_t crc32_boot2(const uint8_t *p, size_t n) {
