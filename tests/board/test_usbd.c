@@ -158,6 +158,13 @@ static int ctl(uint8_t bm, uint8_t req, uint16_t wvalue, uint16_t windex, uint16
     return -2;
 }
 
+/* The fixture of the tests that start from a bus reset, before enumeration. */
+static int setup_reset(void **s) {
+    setup(s);
+    usbd_bus_reset(&dev);
+    return 0;
+}
+
 static void enumerate(void) {
     usbd_bus_reset(&dev);
     uint8_t b[256];
@@ -167,9 +174,15 @@ static void enumerate(void) {
     assert_int_equal(ctl(0x00, 9, 1, 0, 0, NULL), 0);
 }
 
+/* The fixture of the tests that start from an enumerated, configured device. */
+static int setup_configured(void **s) {
+    setup(s);
+    enumerate();
+    return 0;
+}
+
 static void test_device_descriptor(void **s) {
     (void)s;
-    usbd_bus_reset(&dev);
     uint8_t b[256];
     assert_int_equal(ctl(0x80, 6, 0x0100, 0, 8, b), 8); /* first 8 bytes, as Linux asks */
     assert_int_equal(ctl(0x80, 6, 0x0100, 0, 255, b), 18);
@@ -180,7 +193,6 @@ static void test_device_descriptor(void **s) {
 
 static void test_config_descriptor(void **s) {
     (void)s;
-    usbd_bus_reset(&dev);
     uint8_t b[512];
     assert_int_equal(ctl(0x80, 6, 0x0200, 0, 9, b), 9);
     assert_int_equal(b[2] | b[3] << 8, 64);
@@ -188,17 +200,19 @@ static void test_config_descriptor(void **s) {
     zlps = 0;
     /* exactly 64 bytes asked with 255: one full packet then a zero-length one */
     assert_int_equal(ctl(0x80, 6, 0x0200, 0, 255, b), 64);
-    static const uint8_t iface0[9] = {9, 4, 0, 0, 2, 0xFF, 0, 0, 4}, ep1o[7] = {7, 5, 0x01, 2, 64, 0, 0},
-                         ep1i[7] = {7, 5, 0x81, 2, 64, 0, 0}, iface1[9] = {9, 4, 1, 0, 2, 3, 0, 0, 5},
-                         ep2i[7] = {7, 5, 0x82, 3, 64, 0, 1}, ep2o[7] = {7, 5, 0x02, 3, 64, 0, 1};
-    assert_memory_equal(b + 9, iface0, 9);
-    assert_memory_equal(b + 18, ep1o, 7);
-    assert_memory_equal(b + 25, ep1i, 7);
-    assert_memory_equal(b + 32, iface1, 9);
-    assert_int_equal(b[41], 9);
-    assert_int_equal(b[42], 0x21);
-    assert_memory_equal(b + 50, ep2i, 7);
-    assert_memory_equal(b + 57, ep2o, 7);
+    static const struct {
+        int at, n;
+        uint8_t d[9];
+    } want[] = {
+        {9, 9, {9, 4, 0, 0, 2, 0xFF, 0, 0, 4}}, /* interface 0: vendor, 2 endpoints */
+        {18, 7, {7, 5, 0x01, 2, 64, 0, 0}},      /* bulk OUT */
+        {25, 7, {7, 5, 0x81, 2, 64, 0, 0}},      /* bulk IN */
+        {32, 9, {9, 4, 1, 0, 2, 3, 0, 0, 5}},    /* interface 1: HID */
+        {41, 2, {9, 0x21}},                      /* HID descriptor */
+        {50, 7, {7, 5, 0x82, 3, 64, 0, 1}},      /* interrupt IN, 1 ms */
+        {57, 7, {7, 5, 0x02, 3, 64, 0, 1}},      /* interrupt OUT, 1 ms */
+    };
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) assert_memory_equal(b + want[i].at, want[i].d, want[i].n);
     assert_int_equal(ctl(0x81, 6, 0x2200, 1, 255, b), -1); /* interface requests: only once configured */
 }
 
@@ -216,7 +230,6 @@ static void string_is(int index, const char *want) {
 
 static void test_strings(void **s) {
     (void)s;
-    usbd_bus_reset(&dev);
     uint8_t b[8];
     assert_int_equal(ctl(0x80, 6, 0x0300, 0, 255, b), 4);
     assert_int_equal(b[2] | b[3] << 8, 0x0409);
@@ -230,7 +243,6 @@ static void test_strings(void **s) {
 
 static void test_address_after_status(void **s) {
     (void)s;
-    usbd_bus_reset(&dev);
     uint8_t st[8] = {0x00, 5, 42, 0, 0, 0, 0, 0};
     usbd_setup(&dev, st);
     assert_int_equal(addr_now, 0); /* not before the status stage */
@@ -244,7 +256,6 @@ static void test_address_after_status(void **s) {
 
 static void test_configuration_and_status(void **s) {
     (void)s;
-    enumerate();
     uint8_t b[8];
     assert_int_equal(ctl(0x80, 8, 0, 0, 1, b), 1);
     assert_int_equal(b[0], 1);
@@ -275,7 +286,6 @@ static void test_configuration_and_status(void **s) {
 
 static void test_halt_and_clear(void **s) {
     (void)s;
-    enumerate();
     uint8_t b[2];
     assert_int_equal(ctl(0x82, 0, 0, 0x81, 2, b), 2);
     assert_int_equal(b[0], 0);
@@ -301,7 +311,6 @@ static void test_halt_and_clear(void **s) {
 
 static void test_malformed_setups(void **s) {
     (void)s;
-    enumerate();
     uint8_t b[256];
     assert_int_equal(ctl(0x80, 0xFF, 0, 0, 64, b), -1);         /* unknown request */
     assert_int_equal(ctl(0xC0, 1, 0, 0, 64, b), -1);            /* vendor */
@@ -342,7 +351,6 @@ static void test_malformed_setups(void **s) {
  * the device enumerates afterwards. */
 static void test_setup_fuzz(void **s) {
     (void)s;
-    enumerate();
     srand(12345);
     uint8_t b[4096];
     for (int i = 0; i < 20000; i++) {
@@ -424,7 +432,6 @@ static void expect_reply(uint8_t cmd, uint16_t seq, uint8_t status, uint16_t len
 
 static void test_bulk_identify_and_loopback(void **s) {
     (void)s;
-    enumerate();
     static uint8_t req[CBVH_FRAME_MAX], payload[CBVH_FRAME_MAX_PAYLOAD];
     size_t n = request(req, CBVH_CMD_IDENTIFY, 1, NULL, 0);
     host_out(1, req, n, 1);
@@ -452,7 +459,6 @@ static void test_bulk_identify_and_loopback(void **s) {
 
 static void test_hid_link(void **s) {
     (void)s;
-    enumerate();
     static uint8_t req[CBVH_FRAME_MAX], payload[300];
     for (unsigned i = 0; i < sizeof payload; i++) payload[i] = (uint8_t)(255 - i);
     size_t n = request(req, CBVH_CMD_LOOPBACK, 9, payload, sizeof payload);
@@ -485,7 +491,6 @@ static void test_hid_link(void **s) {
 
 static void test_oversized_flood_is_nacked(void **s) {
     (void)s;
-    enumerate();
     static uint8_t junk[20000];
     for (unsigned i = 0; i < sizeof junk; i++) junk[i] = (uint8_t)(i * 13 + 1);
     junk[0] = CBVH_FRAME_MAGIC; /* looks like a frame with a length past 4096 */
@@ -524,7 +529,6 @@ static void test_oversized_flood_is_nacked(void **s) {
 
 static void test_vanished_host(void **s) {
     (void)s;
-    enumerate();
     static uint8_t req[CBVH_FRAME_MAX], payload[2000];
     size_t n = request(req, CBVH_CMD_LOOPBACK, 5, payload, sizeof payload);
     host_out(1, req, n, 1);
@@ -556,18 +560,18 @@ static void test_vanished_host(void **s) {
 
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup(test_device_descriptor, setup),
-        cmocka_unit_test_setup(test_config_descriptor, setup),
-        cmocka_unit_test_setup(test_strings, setup),
-        cmocka_unit_test_setup(test_address_after_status, setup),
-        cmocka_unit_test_setup(test_configuration_and_status, setup),
-        cmocka_unit_test_setup(test_halt_and_clear, setup),
-        cmocka_unit_test_setup(test_malformed_setups, setup),
-        cmocka_unit_test_setup(test_setup_fuzz, setup),
-        cmocka_unit_test_setup(test_bulk_identify_and_loopback, setup),
-        cmocka_unit_test_setup(test_hid_link, setup),
-        cmocka_unit_test_setup(test_oversized_flood_is_nacked, setup),
-        cmocka_unit_test_setup(test_vanished_host, setup),
+        cmocka_unit_test_setup(test_device_descriptor, setup_reset),
+        cmocka_unit_test_setup(test_config_descriptor, setup_reset),
+        cmocka_unit_test_setup(test_strings, setup_reset),
+        cmocka_unit_test_setup(test_address_after_status, setup_reset),
+        cmocka_unit_test_setup(test_configuration_and_status, setup_configured),
+        cmocka_unit_test_setup(test_halt_and_clear, setup_configured),
+        cmocka_unit_test_setup(test_malformed_setups, setup_configured),
+        cmocka_unit_test_setup(test_setup_fuzz, setup_configured),
+        cmocka_unit_test_setup(test_bulk_identify_and_loopback, setup_configured),
+        cmocka_unit_test_setup(test_hid_link, setup_configured),
+        cmocka_unit_test_setup(test_oversized_flood_is_nacked, setup_configured),
+        cmocka_unit_test_setup(test_vanished_host, setup_configured),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -240,12 +240,15 @@ class Fpga {
   setCdone(v) { this.board.mcu.gpio[PIN.CDONE].setInputValue(v); }
   attach(mcu) {
     const pin = (n) => mcu.gpio[n];
-    let creset = null;
-    pin(PIN.CRESET).addListener(() => {
-      const v = pin(PIN.CRESET).outputValue;
-      if (v === creset) return;
-      creset = v;
-      const t = this.now();
+    // fn(level, ns) on each change of an output pin's level
+    const onEdge = (n, fn) => {
+      let last = pin(n).outputValue;
+      pin(n).addListener(() => {
+        const v = pin(n).outputValue;
+        if (v !== last) fn((last = v), this.now());
+      });
+    };
+    onEdge(PIN.CRESET, (v, t) => {
       if (!v) {
         this.state = 'reset';
         this.tFall = t;
@@ -273,11 +276,8 @@ class Fpga {
       mcu.spi[1].completeTransmit(0xff);
     };
     let cs = true;
-    pin(PIN.REG_CS).addListener(() => {
-      const v = pin(PIN.REG_CS).outputValue;
-      if (v === cs) return;
+    onEdge(PIN.REG_CS, (v, t) => {
       cs = v;
-      const t = this.now();
       if (!v) {
         if (this.csHighAt !== undefined) this.minCsGapNs = Math.min(this.minCsGapNs, t - this.csHighAt);
         this.tx = { bytes: [], value: 0 };
