@@ -240,15 +240,16 @@ class Fpga {
   setCdone(v) { this.board.mcu.gpio[PIN.CDONE].setInputValue(v); }
   attach(mcu) {
     const pin = (n) => mcu.gpio[n];
-    // fn(level, ns) on each change of an output pin's level
-    const onEdge = (n, fn) => {
-      let last = pin(n).outputValue;
+    // fn(level, ns) on each change of a pin's output level, from an assumed
+    // initial level (null: the first update counts as a change)
+    const onEdge = (n, initial, fn) => {
+      let last = initial;
       pin(n).addListener(() => {
         const v = pin(n).outputValue;
         if (v !== last) fn((last = v), this.now());
       });
     };
-    onEdge(PIN.CRESET, (v, t) => {
+    onEdge(PIN.CRESET, null, (v, t) => {
       if (!v) {
         this.state = 'reset';
         this.tFall = t;
@@ -276,7 +277,7 @@ class Fpga {
       mcu.spi[1].completeTransmit(0xff);
     };
     let cs = true;
-    onEdge(PIN.REG_CS, (v, t) => {
+    onEdge(PIN.REG_CS, true, (v, t) => {
       cs = v;
       if (!v) {
         if (this.csHighAt !== undefined) this.minCsGapNs = Math.min(this.minCsGapNs, t - this.csHighAt);
