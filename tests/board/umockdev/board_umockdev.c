@@ -4,14 +4,16 @@
  *   board_umockdev [--remove-after-urbs N] [--no-permission] -- COMMAND [ARGS...]
  *
  * Makes a umockdev testbed with the board's sysfs entries (bus 1, device 2,
- * its device and configuration descriptors) and a usbdevfs node
- * /dev/bus/usb/001/002 whose ioctl handler serves the URBs: the board's own
+ * its device and configuration descriptors; interface 1 with usbhid bound,
+ * its hid device and hidraw0) and two nodes: usbdevfs /dev/bus/usb/001/002,
+ * whose ioctl handler serves the URBs, and /dev/hidraw0, whose read, write
+ * and ioctl handlers play the kernel's hidraw + usbhid.  Behind both, the board's own
  * USB device stack (firmware/ports/rp2040_ice40/usbd.c, usb_desc.c,
  * usb_link.c) and the firmware core on the model's register map answer
  * them, packet by packet.  COMMAND runs under umockdev's preload library
- * (umockdev-wrapper), so libusb in it finds and opens this device through
- * the ordinary sysfs/udev and usbdevfs paths.  The exit status is
- * COMMAND's.
+ * (umockdev-wrapper), so libusb, hidapi-libusb and hidapi-hidraw in it find
+ * and open this device through the ordinary sysfs/udev, usbdevfs and hidraw
+ * paths.  The exit status is COMMAND's.
  *
  * --remove-after-urbs N  unplugs the device after N data URBs (a board
  *                        pulled out mid-run): every later ioctl fails with
@@ -22,6 +24,7 @@
 #include <errno.h>
 #include <glib.h>
 #include <glib/gstdio.h>
+#include <linux/hidraw.h>
 #include <linux/usbdevice_fs.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +32,7 @@
 #include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <termios.h>
 #include <unistd.h>
 #include <umockdev.h>
 
@@ -38,6 +42,7 @@
 
 #define DEVNODE "/dev/bus/usb/001/002"
 #define SYSPATH "/sys/devices/pci0000:00/usb1/1-1"
+#define HIDRAW_NODE "/dev/hidraw0"
 #define MAX_PKTS 512
 
 static const char *me = "board_umockdev";
@@ -346,12 +351,102 @@ static gboolean handle_ioctl(UMockdevIoctlBase *h, UMockdevIoctlClient *client, 
     return TRUE;
 }
 
+/* ---- hidraw: the kernel's usbhid between the node and the interrupt pipes ---- */
+
+/* umockdev backs the node with a pty and emulates read()/write() through the
+ * handler, but a poll() sees the pty: a newline is kept in it while input
+ * reports are waiting, so poll(POLLIN) works as on a real hidraw node. */
+static int hidraw_pty = -1;
+static void hidraw_readiness(void) {
+    if (hidraw_pty < 0) return;
+    if (inq[2].head != inq[2].tail) {
+        int pending = 0;
+        if (ioctl(hidraw_pty, TIOCOUTQ, &pending) == 0 && pending == 0 && write(hidraw_pty, "\n", 1) != 1)
+            fprintf(stderr, "%s: cannot signal the hidraw node\n", me);
+    } else {
+        tcflush(hidraw_pty, TCOFLUSH);
+    }
+}
+
+/* After an unplug every call on the node fails with ENODEV: TRUE when so. */
+static gboolean gone(UMockdevIoctlClient *client) {
+    if (removed) umockdev_ioctl_client_complete(client, -1, ENODEV);
+    return removed != 0;
+}
+
+/* read(): one 64-byte input report (no report IDs), or EAGAIN when none. */
+static gboolean hidraw_read(UMockdevIoctlBase *h, UMockdevIoctlClient *client, gpointer user) {
+    (void)h, (void)user;
+    UMockdevIoctlData *arg = umockdev_ioctl_client_get_arg(client);
+    if (gone(client)) return TRUE;
+    if (inq[2].head == inq[2].tail) {
+        umockdev_ioctl_client_complete(client, -1, EAGAIN);
+        return TRUE;
+    }
+    packet *p = &inq[2].q[inq[2].head++ % MAX_PKTS];
+    int k = p->len < arg->data_len ? p->len : arg->data_len;
+    umockdev_ioctl_data_update(arg, 0, p->data, k); /* written back to the reader */
+    umockdev_ioctl_client_complete(client, k, 0);
+    hidraw_readiness();
+    return TRUE;
+}
+
+/* write(): report number 0 then the 64-byte output report, sent on the
+ * interrupt OUT pipe as usbhid does. */
+static gboolean hidraw_write(UMockdevIoctlBase *h, UMockdevIoctlClient *client, gpointer user) {
+    (void)h, (void)user;
+    UMockdevIoctlData *arg = umockdev_ioctl_client_get_arg(client);
+    if (gone(client)) return TRUE;
+    if (arg->data_len < 1 || arg->data[0] != 0 || arg->data_len - 1 > 64) {
+        umockdev_ioctl_client_complete(client, -1, EINVAL);
+        return TRUE;
+    }
+    host_out(2, arg->data + 1, arg->data_len - 1);
+    umockdev_ioctl_client_complete(client, arg->data_len, 0);
+    hidraw_readiness();
+    return TRUE;
+}
+
+static gboolean hidraw_ioctl(UMockdevIoctlBase *h, UMockdevIoctlClient *client, gpointer user) {
+    (void)h, (void)user;
+    gulong req = umockdev_ioctl_client_get_request(client);
+    UMockdevIoctlData *arg = umockdev_ioctl_client_get_arg(client);
+    const uint8_t *rd;
+    uint8_t scratch[64];
+    size_t n = usbd_descriptor(USBD_DESC_HID_REPORT, 0, scratch, &rd);
+    int err = 0;
+    if (req == HIDIOCGRDESCSIZE) {
+        UMockdevIoctlData *d = umockdev_ioctl_data_resolve(arg, 0, sizeof(int), NULL);
+        *(int *)d->data = (int)n;
+        g_object_unref(d);
+    } else if (req == HIDIOCGRDESC) {
+        UMockdevIoctlData *d = umockdev_ioctl_data_resolve(arg, 0, sizeof(struct hidraw_report_descriptor), NULL);
+        struct hidraw_report_descriptor *r = (struct hidraw_report_descriptor *)d->data;
+        r->size = (unsigned)n;
+        memcpy(r->value, rd, n);
+        g_object_unref(d);
+    } else if (req == HIDIOCGRAWINFO) {
+        UMockdevIoctlData *d = umockdev_ioctl_data_resolve(arg, 0, sizeof(struct hidraw_devinfo), NULL);
+        struct hidraw_devinfo *i = (struct hidraw_devinfo *)d->data;
+        i->bustype = 3; /* BUS_USB */
+        i->vendor = (__s16)USBD_VID;
+        i->product = (__s16)USBD_PID;
+        g_object_unref(d);
+    } else {
+        fprintf(stderr, "%s: hidraw ioctl 0x%lx not emulated\n", me, req);
+        err = ENOTTY;
+    }
+    umockdev_ioctl_client_complete(client, err ? -1 : 0, err);
+    return TRUE;
+}
+
 /* The firmware's inter-byte timeout (20 ms), checked every 10 ms. */
 static gboolean idle_tick(gpointer user) {
     (void)user;
     if (cbvh_fw_rx_partial(&fw) && g_get_monotonic_time() - last_rx_us > 20000) {
         cbvh_fw_rx_idle(&fw);
         pump();
+        hidraw_readiness();
     }
     return G_SOURCE_CONTINUE;
 }
@@ -421,6 +516,42 @@ int main(int argc, char **argv) {
     }
     g_free(dev);
     g_free(hex);
+    /* interface 1 with usbhid bound, its hid device and the hidraw node */
+    UMockdevIoctlBase *hidraw = umockdev_ioctl_base_new();
+    g_signal_connect(hidraw, "handle-ioctl", G_CALLBACK(hidraw_ioctl), NULL);
+    g_signal_connect(hidraw, "handle-read", G_CALLBACK(hidraw_read), NULL);
+    g_signal_connect(hidraw, "handle-write", G_CALLBACK(hidraw_write), NULL);
+    if (!umockdev_testbed_attach_ioctl(testbed, HIDRAW_NODE, hidraw, &error)) {
+        fprintf(stderr, "%s: cannot attach %s: %s\n", me, HIDRAW_NODE, error->message);
+        return 1;
+    }
+    GString *rdesc = g_string_new(NULL);
+    {
+        const uint8_t *rd;
+        uint8_t scratch[64];
+        size_t n = usbd_descriptor(USBD_DESC_HID_REPORT, 0, scratch, &rd);
+        for (size_t k = 0; k < n; k++) g_string_append_printf(rdesc, "%02x", rd[k]);
+    }
+    char *hid = g_strdup_printf(
+        "P: /devices/pci0000:00/usb1/1-1/1-1:1.1\nE: SUBSYSTEM=usb\nE: DEVTYPE=usb_interface\nE: DRIVER=usbhid\n"
+        "A: bInterfaceNumber=01\\n\nA: bInterfaceClass=03\\n\n\n"
+        "P: /devices/pci0000:00/usb1/1-1/1-1:1.1/0003:1209:C0B1.0001\nE: SUBSYSTEM=hid\nE: DRIVER=hid-generic\n"
+        "E: HID_ID=0003:00001209:0000C0B1\nE: HID_NAME=cbvh cbvh board\nE: HID_PHYS=usb-0000:00:00.0-1/input1\n"
+        "E: HID_UNIQ=0001\nH: report_descriptor=%s\n\n"
+        "P: /devices/pci0000:00/usb1/1-1/1-1:1.1/0003:1209:C0B1.0001/hidraw/hidraw0\nN: hidraw0\n"
+        "E: SUBSYSTEM=hidraw\nE: DEVNAME=" HIDRAW_NODE "\nE: MAJOR=240\nE: MINOR=0\n",
+        rdesc->str);
+    g_string_free(rdesc, TRUE);
+    if (!umockdev_testbed_add_from_string(testbed, hid, &error)) {
+        fprintf(stderr, "%s: cannot add the hidraw device: %s\n", me, error->message);
+        return 1;
+    }
+    g_free(hid);
+    hidraw_pty = umockdev_testbed_get_dev_fd(testbed, HIDRAW_NODE);
+    /* hidraw0/device -> the hid device, as the kernel links it (hidapi reads uevent and
+     * report_descriptor through it) */
+    umockdev_testbed_set_attribute_link(testbed, SYSPATH "/1-1:1.1/0003:1209:C0B1.0001/hidraw/hidraw0", "device",
+                                        "../..");
     char *root = umockdev_testbed_get_root_dir(testbed);
     GPtrArray *cmd = g_ptr_array_new();
     if (no_permission) { /* as a user the udev rule did not let in */
@@ -457,6 +588,7 @@ int main(int argc, char **argv) {
     g_ptr_array_free(cmd, TRUE);
     g_free(root);
     g_object_unref(handler);
+    g_object_unref(hidraw);
     g_object_unref(testbed);
     return child_status;
 }

@@ -3,7 +3,9 @@
 # the host's real libusb and hidapi-libusb code paths against the board's
 # own USB stack and firmware core.
 #   run_umockdev.sh BOARD_UMOCKDEV CBVH VECTORS CASE
-# CASE: devices | vectors_usb | vectors_hid | unplug | permission.
+# CASE: devices | vectors_usb | vectors_hid | unplug | permission (CBVH = cbvh,
+# hidapi-libusb), devices_hidraw | vectors_hidraw (CBVH = cbvh_hidraw, cbvh
+# built against hidapi-hidraw).
 # Exit 77 (ctest SKIP) when umockdev is not installed (scripts/install-deps).
 set -u
 board=$1 cbvh=$2 vectors=$3 case=$4
@@ -17,6 +19,13 @@ run() { # run [board options] -- cbvh args: output in $tmp/out, $tmp/err; status
     rc=$?
     cat "$tmp/out" "$tmp/err"
 }
+# vectors_ok BACKEND PASSED: every sampled vector passed on
+# the board through that backend
+vectors_ok() {
+    [ $rc -eq 0 ] || fail "cbvh vectors check exit $rc"
+    grep -q "^backend: $1 1209:c0b1 cbvh-rp2040 " "$tmp/out" || fail "not the $1 board"
+    grep -q "^total: 76 files, $2 passed, 0 failed" "$tmp/out" || fail "not every sampled vector passed"
+}
 case $case in
 devices)
     run -- "$cbvh" devices
@@ -26,15 +35,11 @@ devices)
 vectors_usb)
     # --backend auto must pick the board: no fallback line
     run -- "$cbvh" vectors check --sample 20 -q "$vectors"
-    [ $rc -eq 0 ] || fail "cbvh vectors check exit $rc"
-    grep -q '^backend: usb 1209:c0b1 cbvh-rp2040 ' "$tmp/out" || fail "auto did not pick the usb board"
-    grep -q 'no board found' "$tmp/err" && fail "auto fell back to the model"
-    grep -q '^total: 76 files, 1520 passed, 0 failed' "$tmp/out" || fail "not every sampled vector passed" ;;
+    vectors_ok usb 1520
+    grep -q 'no board found' "$tmp/err" && fail "auto fell back to the model" ;;
 vectors_hid)
     run -- "$cbvh" vectors check --backend hid --sample 10 -q "$vectors"
-    [ $rc -eq 0 ] || fail "cbvh vectors check --backend hid exit $rc"
-    grep -q '^backend: hid 1209:c0b1 cbvh-rp2040 ' "$tmp/out" || fail "not the hid board"
-    grep -q '^total: 76 files, 760 passed, 0 failed' "$tmp/out" || fail "not every sampled vector passed" ;;
+    vectors_ok hid 760 ;;
 unplug)
     # pulled out after 100 data URBs: the documented 'link lost' error, exit
     # non-zero, the vectors named as not run, nothing reported as passed
@@ -54,6 +59,13 @@ permission)
     [ $rc -ne 0 ] || fail "vectors check without permission exit 0"
     grep -q "found but cannot be opened: Access denied .*install firmware/udev/60-cbvh.rules" "$tmp/err" ||
         fail "no udev hint from vectors check" ;;
+devices_hidraw)
+    run -- "$cbvh" devices
+    [ $rc -eq 0 ] || fail "cbvh devices exit $rc"
+    grep -q '^hid:   1209:c0b1 /dev/hidraw0 "cbvh board" serial 0001$' "$tmp/out" || fail "hidapi-hidraw did not list the board" ;;
+vectors_hidraw)
+    run -- "$cbvh" vectors check --backend hid --sample 5 -q "$vectors"
+    vectors_ok hid 380 ;;
 *) echo "run_umockdev.sh: unknown case '$case'"; exit 2 ;;
 esac
 echo "ok: $case"
