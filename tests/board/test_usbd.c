@@ -17,6 +17,7 @@
 #include <cmocka.h>
 
 #include "cbvh_fw/fw.h"
+#include "cbvh_fw/payload.h"
 #include "cbvh_sim.h"
 #include "usb_link.h"
 #include "usbd.h"
