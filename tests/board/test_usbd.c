@@ -55,7 +55,7 @@ static void m_xfer(void *c, uint8_t ep, uint8_t *data, uint16_t len) {
     e->armed = 1;
     e->len = len;
     e->dst = data;
-    if (ep & 0x80) memcpy(e->data, data, len);
+    if ((ep & 0x80) && len) memcpy(e->data, data, len);
 }
 static void m_abort(void *c, uint8_t ep) {
     (void)c;

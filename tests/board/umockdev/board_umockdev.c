@@ -102,7 +102,7 @@ static void p_xfer(void *c, uint8_t ep, uint8_t *data, uint16_t len) {
     if (ep & 0x80u) { /* the host controller takes the packet now; an IN URB collects it */
         if (inq[n].tail - inq[n].head >= MAX_PKTS) return;
         packet *p = &inq[n].q[inq[n].tail++ % MAX_PKTS];
-        memcpy(p->data, data, len);
+        if (len) memcpy(p->data, data, len);
         p->len = len;
         complete_later(ep, len);
     } else if (n == 0) {
