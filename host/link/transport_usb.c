@@ -50,7 +50,14 @@ static int usb_attach(usb_state *s, char *err, size_t errlen, int *none) {
         }
         struct libusb_config_descriptor *cfg = NULL;
         uint8_t in = 0, out = 0;
-        if (libusb_get_active_config_descriptor(list[i], &cfg) == 0 && cfg->bNumInterfaces > USB_IFACE) {
+        int crc = libusb_get_active_config_descriptor(list[i], &cfg);
+        if (crc != 0) { /* e.g. unplugged between the listing and here: not a wrong device */
+            libusb_close(h);
+            snprintf(err, errlen, "device %04x:%04x: cannot read its configuration (%s)", vid, pid,
+                     libusb_strerror(crc));
+            continue;
+        }
+        if (cfg->bNumInterfaces > USB_IFACE) {
             const struct libusb_interface_descriptor *id = &cfg->interface[USB_IFACE].altsetting[0];
             for (int e = 0; e < id->bNumEndpoints; e++) {
                 const struct libusb_endpoint_descriptor *ep = &id->endpoint[e];
