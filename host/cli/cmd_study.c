@@ -10,12 +10,9 @@
 #include "cbvh/cbvh_tree.h"
 #include "cbvh/oom.h"
 #include "cli/commands.h"
+#include "cli/data_dir.h"
 #include "util/parse_int.h"
 #include "scene/scene_load.h"
-
-#ifndef CBVH_SCENES_DIR
-#define CBVH_SCENES_DIR "scenes"
-#endif
 
 /* Sec. 5.2 memory-traffic model (bytes). */
 enum {
@@ -284,7 +281,9 @@ static void usage(FILE *f) {
 }
 
 int cmd_study(int argc, char **argv) {
-    const char *defaults[] = {CBVH_SCENES_DIR "/bunny-small.obj", "proc:cloth", "proc:far", "proc:wave"};
+    char bunny[PATH_MAX];
+    snprintf(bunny, sizeof bunny, "%s/scenes/bunny-small.obj", cbvh_data_dir());
+    const char *defaults[] = {bunny, "proc:cloth", "proc:far", "proc:wave"};
     const char **specs = malloc((size_t)(argc + 4) * sizeof *specs);
     int ns = 0, json = 0, sweep = 1;
     cbvh_params p = {6, CBVH_MIN_SCALE_DEFAULT};
