@@ -7,6 +7,7 @@
  *      every CBVH gives exactly the float BVH's hits. */
 #include <errno.h>
 #include <getopt.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,17 +17,19 @@
 
 #include "link/backend.h"
 #include "cli/commands.h"
+#include "cli/data_dir.h"
 #include "trace/effects.h"
 #include "trace/metrics.h"
 #include "scene/scene_file.h"
 #include "trace/timing_model.h"
 #include "vectors/vectors_check.h"
 
-/* The defaults are the source tree's committed vectors and bundled scene
- * wherever cbvh runs: a ./vectors or ./scenes of the working directory is
- * not what the help promises.  Explicit paths stay relative to the cwd. */
-#define DEFAULT_VECTORS CBVH_SOURCE_DIR "/vectors"
-#define DEFAULT_SCENE CBVH_SOURCE_DIR "/scenes/bunny.scene"
+/* The defaults are the committed vectors and the bundled scene, installed
+ * (PREFIX/share/cbvh) or in the source tree (cli/data_dir.c), wherever cbvh
+ * runs: a ./vectors or ./scenes of the working directory is not what the help
+ * promises.  Explicit paths stay relative to the cwd. */
+#define DEFAULT_VECTORS "vectors"
+#define DEFAULT_SCENE "scenes/bunny.scene"
 
 static void usage(FILE *f) {
     fprintf(f,
@@ -39,10 +42,10 @@ static void usage(FILE *f) {
             "the float BVH, and whether the hits are identical.\n"
             "\n"
             "  --backend SPEC  auto (default), model, usb, hid, sim:ADDR\n"
-            "  --vectors DIR   vector directory (default: the committed vectors/ of the source tree,\n"
-            "                  from any working directory)\n"
+            "  --vectors DIR   vector directory (default: the committed vectors/, installed in\n"
+            "                  PREFIX/share/cbvh or of the source tree, from any working directory)\n"
             "  --scene SCENE   scene file, or a mesh file / proc:NAME with its default scene\n"
-            "                  (default: the source tree's scenes/bunny.scene; docs/scenes.md)\n"
+            "                  (default: scenes/bunny.scene beside those vectors; docs/scenes.md)\n"
             "  --json          one JSON object instead of tables\n");
 }
 
@@ -101,8 +104,15 @@ int cmd_run(int argc, char **argv) {
         fprintf(stderr, "cbvh run: unexpected argument '%s'\n", argv[optind]);
         return 2;
     }
-    if (!vec_dir) vec_dir = DEFAULT_VECTORS;
-    if (!scene_path) scene_path = DEFAULT_SCENE;
+    char def_vectors[PATH_MAX], def_scene[PATH_MAX];
+    if (!vec_dir) {
+        snprintf(def_vectors, sizeof def_vectors, "%s/" DEFAULT_VECTORS, cbvh_data_dir());
+        vec_dir = def_vectors;
+    }
+    if (!scene_path) {
+        snprintf(def_scene, sizeof def_scene, "%s/" DEFAULT_SCENE, cbvh_data_dir());
+        scene_path = def_scene;
+    }
     /* Options first, then the scene (a typo in --scene is reported at once,
      * not after a whole vector check on a board): nothing is printed before. */
     struct stat vst;

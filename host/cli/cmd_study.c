@@ -11,12 +11,9 @@
 #include "cbvh/cbvh_tree.h"
 #include "cbvh/oom.h"
 #include "cli/commands.h"
+#include "cli/data_dir.h"
 #include "util/parse_int.h"
 #include "scene/scene_load.h"
-
-#ifndef CBVH_SCENES_DIR
-#define CBVH_SCENES_DIR "scenes"
-#endif
 
 /* Sec. 5.2 memory-traffic model (bytes). */
 enum {
@@ -395,7 +392,9 @@ static int parse_options(int argc, char **argv, study_opts *o) {
 }
 
 int cmd_study(int argc, char **argv) {
-    const char *defaults[] = {CBVH_SCENES_DIR "/bunny-small.obj", "proc:cloth", "proc:far", "proc:wave"};
+    char bunny[PATH_MAX];
+    snprintf(bunny, sizeof bunny, "%s/scenes/bunny-small.obj", cbvh_data_dir());
+    const char *defaults[] = {bunny, "proc:cloth", "proc:far", "proc:wave"};
     study_opts o = {malloc((size_t)(argc + 4) * sizeof *o.specs), 0, 0, 1, {6, CBVH_MIN_SCALE_DEFAULT}};
     if (!o.specs) cbvh_out_of_memory("scene list");
     int rc = parse_options(argc, argv, &o);
