@@ -142,6 +142,10 @@ int cbvh_timing_units_for(const cbvh_cost_table *t, const cbvh_timing_params *p,
     return 0;
 }
 
+double cbvh_build_cycles(const cbvh_timing_params *p, double bytes, double round_trips) {
+    return bytes / p->dram_bytes_per_cycle + round_trips * p->fetch_latency;
+}
+
 const char *cbvh_timing_bound_name(cbvh_timing_bound b) {
     static const char *const names[CBVH_BOUND_COUNT] = {"latency", "node unit", "triangle unit", "decoder",
                                                         "stack unit", "DRAM"};

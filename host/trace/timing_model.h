@@ -113,6 +113,13 @@ typedef struct {
 int cbvh_timing_eval(const cbvh_timing_params *p, const cbvh_timing_units *u, const cbvh_timing_work *w,
                      cbvh_timing_result *out);
 
+/* The build side (docs/timing_model.md §7): a streaming pass that moves
+ * `bytes` over the DRAM interface, bandwidth-bound, plus `round_trips`
+ * dependent DRAM reads one after another (seed 003's backtracking unit
+ * works sequentially), each waiting the DRAM latency (its 128 bytes are
+ * among `bytes`).  Cycles: bytes / bandwidth + round_trips x latency. */
+double cbvh_build_cycles(const cbvh_timing_params *p, double bytes, double round_trips);
+
 /* Cache energy per 64-bit word read, pJ: sram_pj_per_word x sqrt(kb / 8);
  * 0 for no cache and for the infinite (ideal) one. */
 double cbvh_timing_word_pj(const cbvh_timing_params *p, double cache_kb);

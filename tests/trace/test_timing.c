@@ -209,6 +209,18 @@ static void v1_corner(void **state) {
     assert_float_equal(r.seconds, 1.57e-6, 1e-18);
 }
 
+/* The build side (docs/timing_model.md §7): streamed bytes at the bandwidth
+ * and the backtracking unit's round trips one after another. */
+static void build_time(void **state) {
+    (void)state;
+    cbvh_timing_params p;
+    cbvh_timing_defaults(&p);
+    /* a float LBVH of 100 triangles, 99 inner nodes: (40 + 64 + 4) x 100 + 64 x 99 bytes */
+    assert_float_equal(cbvh_build_cycles(&p, 17136, 0), 17136 / 12.8, 1e-9);
+    /* streaming with 3 backtracks: 108 x 100 + 16 x 99 + 128 x 3 bytes and 3 round trips of 100 cycles */
+    assert_float_equal(cbvh_build_cycles(&p, 10800 + 1584 + 384, 3), 12768 / 12.8 + 300, 1e-9);
+}
+
 static void timing_set(void **state) {
     (void)state;
     cbvh_timing_params p;
@@ -579,6 +591,7 @@ int main(void) {
         cmocka_unit_test(worked_example),
         cmocka_unit_test(v1_corner),
         cmocka_unit_test(timing_set),
+        cmocka_unit_test(build_time),
         cmocka_unit_test(cache_lru),
         cmocka_unit_test(memsim_counts),
         cmocka_unit_test(event_example),
