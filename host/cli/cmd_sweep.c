@@ -293,11 +293,7 @@ static cJSON *json_costs(const cbvh_fx_stats *s, const cbvh_fx_stats *f, uint64_
         cJSON_AddItemToArray(model, mo);
         json_rel(mo, "cache_kb", ms->mc[c].cache_kb); /* null: infinite */
         cJSON_AddNumberToObject(mo, "ns_per_ray", a.model_ns);
-        cJSON_AddNumberToObject(mo, "energy_nj_per_ray", a.energy_nj);
-        cJSON_AddNumberToObject(mo, "area_lut4", a.area_lut4);
-        cJSON_AddNumberToObject(mo, "dram_bytes_per_ray", a.dram_bytes);
-        cJSON_AddNumberToObject(mo, "hit_rate", a.hit_rate);
-        cJSON_AddStringToObject(mo, "bound", cbvh_timing_bound_name(a.bound));
+        cbvh_model_json(mo, &a);
         cJSON_AddNumberToObject(mo, "false_positive_box_hits_per_ray", 0); /* the exact unit: none (issue 35) */
         cJSON_AddNumberToObject(mo, "extra_tri_tests_per_ray", 0);
         cJSON *mr = cJSON_AddObjectToObject(mo, "relative_to_float");
@@ -551,6 +547,16 @@ static int set_scene(sweep_cli *c, const char *a) {
     return 0;
 }
 
+/* An option naming a directory: not empty.  0 or -1. */
+static int directory(const char *opt, const char *v, const char **dst) {
+    if (!v[0]) {
+        fprintf(stderr, "cbvh sweep: %s expects a directory\n", opt);
+        return -1;
+    }
+    *dst = v;
+    return 0;
+}
+
 /* One option and its value ("" when missing: each option's own message). */
 static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli *c) {
     cbvh_sweep_opts *o = &c->run;
@@ -580,13 +586,7 @@ static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli
             return -1;
         }
         return 0;
-    case OPT_OUT:
-        if (!v[0]) {
-            fprintf(stderr, "cbvh sweep: --out expects a directory\n");
-            return -1;
-        }
-        c->outdir = v;
-        return 0;
+    case OPT_OUT: return directory("--out", v, &c->outdir);
     case OPT_HEATMAP:
         if (list_again("--heatmap", &c->heat_given)) return -1;
         return parse_heatmaps(v, argc, argv, c);
@@ -606,13 +606,7 @@ static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli
     case OPT_TIMING:
         c->timing = v;
         return 0;
-    case OPT_COST_TABLE:
-        if (!v[0]) {
-            fprintf(stderr, "cbvh sweep: --cost-table expects a directory\n");
-            return -1;
-        }
-        c->cost_dir = v;
-        return 0;
+    case OPT_COST_TABLE: return directory("--cost-table", v, &c->cost_dir);
     default: /* OPT_TEST_CORRUPT */
         return parse_corrupt(v, o);
     }
@@ -930,15 +924,6 @@ static const char *cfg_name(const sweep_cli *c, const cbvh_sweep_result *res, in
     return name;
 }
 
-/* The cache size in a file name: C64, Cnone, Cinf. */
-static void cache_tag(double kb, char *out, size_t n) {
-    if (isinf(kb))
-        snprintf(out, n, "Cinf");
-    else if (!(kb > 0))
-        snprintf(out, n, "Cnone");
-    else
-        snprintf(out, n, "C%g", kb);
-}
 
 /* time-*.svg and energy-*.svg: the model's time and energy per ray against N,
  * one line per M and one for the float BVH, per min scale (and box unit)
@@ -973,11 +958,11 @@ static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, con
                 for (size_t i = 0; i < (size_t)(nm + 1) * f->nb; i++) ok &= isfinite(y[i]) != 0;
                 if (!ok) continue;
                 char tag[32], cn[32], path[2048], title[1400], err[1024];
-                cache_tag(o->cache_kb[ci], tag, sizeof tag);
+                cbvh_cache_name_unit(o->cache_kb[ci], "", tag, sizeof tag);
                 if (o->nmin_scale == 1)
-                    snprintf(path, sizeof path, "%s/%s-%s.svg", c->outdir, q ? "energy" : "time", tag);
+                    snprintf(path, sizeof path, "%s/%s-C%s.svg", c->outdir, q ? "energy" : "time", tag);
                 else
-                    snprintf(path, sizeof path, "%s/%s-E%d-%s.svg", c->outdir, q ? "energy" : "time",
+                    snprintf(path, sizeof path, "%s/%s-E%d-C%s.svg", c->outdir, q ? "energy" : "time",
                              o->min_scale[e], tag);
                 snprintf(title, sizeof title, "%s: modelled %s per ray, cache %s, min scale %d, %s box unit", mesh,
                          q ? "energy" : "time", cbvh_cache_name(o->cache_kb[ci], cn, sizeof cn), o->min_scale[e],
@@ -1132,39 +1117,20 @@ static void json_effects(cJSON *o, const cbvh_scene_desc *d, const sweep_figures
     for (int ci = 0; ci < f->ncaches; ci++) cJSON_AddItemToArray(pa, cJSON_CreateBool(f->pareto[(size_t)k * f->ncaches + ci]));
 }
 
-static cJSON *json_unit(const cbvh_unit_cost *u) {
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "unit", u->unit);
-    cJSON_AddNumberToObject(o, "latency", u->latency);
-    cJSON_AddNumberToObject(o, "ii", u->ii);
-    cJSON_AddNumberToObject(o, "instances", u->instances);
-    cJSON_AddNumberToObject(o, "lut4_each", u->lut4);
-    cJSON_AddNumberToObject(o, "energy_pj_per_op", u->energy_pj);
-    return o;
-}
-
 static void json_machine(cJSON *root, const sweep_cli *c, const sweep_figures *f) {
-    const cbvh_timing_params *tp = &f->tp;
     cJSON *tj = cJSON_AddObjectToObject(root, "timing");
-    const char *keys[] = {"clock_mhz", "rays_in_flight", "dram_bytes_per_cycle", "fetch_latency", "cache_hit_latency",
-                          "cache_ways", "unit_cycle_scale", "dram_pj_per_byte", "sram_pj_per_word",
-                          "add_pj_per_bit", "mul_pj_per_pp_bit"};
-    const double vals[] = {tp->clock_mhz,        tp->rays_in_flight,  tp->dram_bytes_per_cycle, tp->fetch_latency,
-                           tp->cache_hit_latency, tp->cache_ways,      tp->unit_cycle_scale,     tp->dram_pj_per_byte,
-                           tp->sram_pj_per_word,  tp->add_pj_per_bit, tp->mul_pj_per_pp_bit};
-    for (size_t i = 0; i < sizeof vals / sizeof vals[0]; i++) cJSON_AddNumberToObject(tj, keys[i], vals[i]);
-    cJSON_AddStringToObject(tj, "cost_table", c->cost_dir);
+    cbvh_timing_json(tj, &f->tp, c->cost_dir);
     cJSON *ca = cJSON_AddArrayToObject(tj, "caches_kb");
     for (int ci = 0; ci < f->ncaches; ci++)
         cJSON_AddItemToArray(ca, isfinite(c->run.cache_kb[ci]) ? cJSON_CreateNumber(c->run.cache_kb[ci]) : cJSON_CreateNull());
     cJSON_AddNumberToObject(tj, "cpu_reps", c->run.reps);
     cJSON *un = cJSON_AddObjectToObject(tj, "units");
     const cbvh_timing_units *fu = &f->cm[0].mc[0].units;
-    cJSON_AddItemToObject(un, "box", json_unit(&fu->node));
-    cJSON_AddItemToObject(un, "triangle", json_unit(&fu->tri));
+    cJSON_AddItemToObject(un, "box", cbvh_unit_json(&fu->node));
+    cJSON_AddItemToObject(un, "triangle", cbvh_unit_json(&fu->tri));
     if (f->res.nrows) {
         cJSON *dec = cJSON_AddArrayToObject(un, "decoder");
-        for (int b = 0; b < f->nb; b++) cJSON_AddItemToArray(dec, json_unit(&f->cm[1 + b].mc[0].units.dec));
+        for (int b = 0; b < f->nb; b++) cJSON_AddItemToArray(dec, cbvh_unit_json(&f->cm[1 + b].mc[0].units.dec));
     }
 }
 

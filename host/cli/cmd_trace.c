@@ -125,10 +125,7 @@ static cJSON *json_stats(const cbvh_fx_stats *s, const cbvh_machine *mc) {
     json_g6(o, "tri_per_ray", p.tri);
     json_g6(o, "bytes_per_ray", p.bytes);
     json_g6(o, "model_ns_per_ray", p.model_ns);
-    json_g6(o, "energy_nj_per_ray", p.energy_nj);
-    json_g6(o, "dram_bytes_per_ray", p.dram_bytes);
-    json_g6(o, "hit_rate", p.hit_rate);
-    cJSON_AddStringToObject(o, "bound", cbvh_timing_bound_name(p.bound));
+    cbvh_model_json(o, &p);
     json_g6(o, "cpu_us_per_ray", p.cpu_us);
     json_g6(o, "cpu_us_per_ray_min", p.cpu_lo);
     json_g6(o, "cpu_us_per_ray_max", p.cpu_hi);
@@ -212,20 +209,13 @@ static int set_option(trace_opts *t, int opt, const char *v) {
         }
         return 0;
     }
-    if (opt == 'M') {
+    if (opt == 'M' || opt == 'T') { /* --timing, --cost-table: a non-empty word */
         if (!v || !v[0]) {
-            fprintf(stderr, "cbvh trace: --timing expects key=value[,key=value...]\n");
+            fprintf(stderr, "cbvh trace: %s\n", opt == 'M' ? "--timing expects key=value[,key=value...]"
+                                                            : "--cost-table expects a directory");
             return 2;
         }
-        t->timing = v;
-        return 0;
-    }
-    if (opt == 'T') {
-        if (!v || !v[0]) {
-            fprintf(stderr, "cbvh trace: --cost-table expects a directory\n");
-            return 2;
-        }
-        t->cost_dir = v;
+        *(opt == 'M' ? &t->timing : &t->cost_dir) = v;
         return 0;
     }
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) {
@@ -341,35 +331,17 @@ typedef struct {
 
 static void json_machine(cJSON *root, const cbvh_timing_params *tp, const trace_opts *t, const trace_models *tm) {
     cJSON *tj = cJSON_AddObjectToObject(root, "timing");
-    json_g6(tj, "clock_mhz", tp->clock_mhz);
-    json_g6(tj, "rays_in_flight", tp->rays_in_flight);
-    json_g6(tj, "fetch_latency", tp->fetch_latency);
-    json_g6(tj, "dram_bytes_per_cycle", tp->dram_bytes_per_cycle);
-    json_g6(tj, "cache_hit_latency", tp->cache_hit_latency);
-    json_g6(tj, "cache_ways", tp->cache_ways);
+    cbvh_timing_json(tj, tp, t->cost_dir);
     if (isfinite(t->cache_kb))
         json_g6(tj, "cache_kb", t->cache_kb);
     else
         cJSON_AddNullToObject(tj, "cache_kb");
-    json_g6(tj, "unit_cycle_scale", tp->unit_cycle_scale);
-    json_g6(tj, "dram_pj_per_byte", tp->dram_pj_per_byte);
-    json_g6(tj, "sram_pj_per_word", tp->sram_pj_per_word);
-    cJSON_AddStringToObject(tj, "cost_table", t->cost_dir);
     cJSON_AddNumberToObject(tj, "cpu_reps", t->reps);
     const cbvh_unit_cost *u[] = {&tm->m.mc[0].units.node, &tm->m.mc[0].units.tri, &tm->m.mc[0].units.dec,
                                  &tm->m.mc[0].units.qstack};
     cJSON *ua = cJSON_AddArrayToObject(tj, "units");
-    for (int k = 0; k < 4; k++) {
-        if (!u[k]->present) continue;
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddItemToArray(ua, o);
-        cJSON_AddStringToObject(o, "unit", u[k]->unit);
-        json_g6(o, "latency", u[k]->latency);
-        json_g6(o, "ii", u[k]->ii);
-        json_g6(o, "instances", u[k]->instances);
-        json_g6(o, "lut4_each", u[k]->lut4);
-        json_g6(o, "energy_pj_per_op", u[k]->energy_pj);
-    }
+    for (int k = 0; k < 4; k++)
+        if (u[k]->present) cJSON_AddItemToArray(ua, cbvh_unit_json(u[k]));
 }
 
 static void write_json(const trace_opts *t, const cbvh_scene_desc *d, const cbvh_fx_result *rf,

@@ -21,14 +21,50 @@ int cbvh_config_model_init(cbvh_config_model *cm, const cbvh_fx_result *r, const
     return 0;
 }
 
-const char *cbvh_cache_name(double kb, char *buf, size_t n) {
+const char *cbvh_cache_name_unit(double kb, const char *unit, char *buf, size_t n) {
     if (isinf(kb))
         snprintf(buf, n, "inf");
     else if (!(kb > 0))
         snprintf(buf, n, "none");
     else
-        snprintf(buf, n, "%g KB", kb);
+        snprintf(buf, n, "%g%s", kb, unit);
     return buf;
+}
+
+void cbvh_timing_json(cJSON *o, const cbvh_timing_params *tp, const char *cost_dir) {
+    const char *keys[] = {"clock_mhz",        "rays_in_flight",  "dram_bytes_per_cycle", "fetch_latency",
+                          "cache_hit_latency", "cache_ways",      "unit_cycle_scale",     "box_cycles",
+                          "tri_cycles",       "dram_pj_per_byte", "sram_pj_per_word",     "add_pj_per_bit",
+                          "mul_pj_per_pp_bit"};
+    const double vals[] = {tp->clock_mhz,        tp->rays_in_flight,   tp->dram_bytes_per_cycle, tp->fetch_latency,
+                           tp->cache_hit_latency, tp->cache_ways,       tp->unit_cycle_scale,     tp->box_cycles,
+                           tp->tri_cycles,        tp->dram_pj_per_byte, tp->sram_pj_per_word,     tp->add_pj_per_bit,
+                           tp->mul_pj_per_pp_bit};
+    for (size_t i = 0; i < sizeof vals / sizeof vals[0]; i++)
+        if (isfinite(vals[i]))
+            cJSON_AddNumberToObject(o, keys[i], vals[i]);
+        else
+            cJSON_AddNullToObject(o, keys[i]); /* box_cycles, tri_cycles: the cost table's */
+    cJSON_AddStringToObject(o, "cost_table", cost_dir);
+}
+
+cJSON *cbvh_unit_json(const cbvh_unit_cost *u) {
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "unit", u->unit);
+    cJSON_AddNumberToObject(o, "latency", u->latency);
+    cJSON_AddNumberToObject(o, "ii", u->ii);
+    cJSON_AddNumberToObject(o, "instances", u->instances);
+    cJSON_AddNumberToObject(o, "lut4_each", u->lut4);
+    cJSON_AddNumberToObject(o, "energy_pj_per_op", u->energy_pj);
+    return o;
+}
+
+void cbvh_model_json(cJSON *o, const cbvh_ray_metrics *m) {
+    cJSON_AddNumberToObject(o, "energy_nj_per_ray", m->energy_nj);
+    cJSON_AddNumberToObject(o, "area_lut4", m->area_lut4);
+    cJSON_AddNumberToObject(o, "dram_bytes_per_ray", m->dram_bytes);
+    cJSON_AddNumberToObject(o, "hit_rate", m->hit_rate);
+    cJSON_AddStringToObject(o, "bound", cbvh_timing_bound_name(m->bound));
 }
 
 int cbvh_cache_kb_parse(const char *s, double *kb) {

@@ -7,6 +7,8 @@
 
 #include <stddef.h>
 
+#include <cjson/cJSON.h>
+
 #include "trace/cost_table.h"
 #include "trace/effects.h"
 #include "trace/metrics.h"
@@ -24,8 +26,23 @@ typedef struct {
 int cbvh_config_model_init(cbvh_config_model *cm, const cbvh_fx_result *r, const cbvh_cost_table *t,
                            const cbvh_timing_params *tp, const char *box_unit, int n, int m, char *err, size_t errlen);
 
-/* A cache size for tables: "none", "inf", "64 KB". */
-const char *cbvh_cache_name(double kb, char *buf, size_t n);
+/* A cache size for tables: "none", "inf", "64 KB"; with unit = "" for file
+ * names: "none", "inf", "64". */
+const char *cbvh_cache_name_unit(double kb, const char *unit, char *buf, size_t n);
+static inline const char *cbvh_cache_name(double kb, char *buf, size_t n) {
+    return cbvh_cache_name_unit(kb, " KB", buf, n);
+}
+
+/* The machine's parameters into a JSON object ("timing"): every key of
+ * cbvh_timing_set and the energies per bit, the cost table's folder. */
+void cbvh_timing_json(cJSON *o, const cbvh_timing_params *tp, const char *cost_dir);
+/* A unit as the model sees it: unit, latency, ii, instances, lut4_each,
+ * energy_pj_per_op. */
+cJSON *cbvh_unit_json(const cbvh_unit_cost *u);
+
+/* The timing model's figures of a set of rays into a JSON object:
+ * energy_nj_per_ray, area_lut4, dram_bytes_per_ray, hit_rate, bound. */
+void cbvh_model_json(cJSON *o, const cbvh_ray_metrics *m);
 
 /* "--cache" values: an integer 0 .. CBVH_CACHE_KB_MAX (KB; 0 = no cache) or
  * "inf".  0 or -1. */
