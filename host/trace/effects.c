@@ -387,10 +387,10 @@ void cbvh_fx_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp) {
     const cbvh_timing_overrides *o = &d->timing;
     const double *src[] = {&o->box_cycles, &o->tri_cycles, &o->fetch_latency, &o->dram_bytes_per_cycle,
                            &o->clock_mhz, &o->rays_in_flight, &o->cache_hit_latency, &o->cache_ways,
-                           &o->unit_cycle_scale, &o->dram_pj_per_byte, &o->sram_pj_per_word};
+                           &o->unit_cycle_scale, &o->dram_pj_per_byte, &o->sram_pj_per_word, &o->issue_width};
     double *dst[] = {&tp->box_cycles, &tp->tri_cycles, &tp->fetch_latency, &tp->dram_bytes_per_cycle,
                      &tp->clock_mhz, &tp->rays_in_flight, &tp->cache_hit_latency, &tp->cache_ways,
-                     &tp->unit_cycle_scale, &tp->dram_pj_per_byte, &tp->sram_pj_per_word};
+                     &tp->unit_cycle_scale, &tp->dram_pj_per_byte, &tp->sram_pj_per_word, &tp->issue_width};
     for (size_t i = 0; i < sizeof src / sizeof src[0]; i++)
         if (!isnan(*src[i])) *dst[i] = *src[i];
 }

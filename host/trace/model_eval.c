@@ -33,11 +33,11 @@ const char *cbvh_cache_name_unit(double kb, const char *unit, char *buf, size_t 
 
 void cbvh_timing_json(cJSON *o, const cbvh_timing_params *tp, const char *cost_dir) {
     const char *keys[] = {"clock_mhz",        "rays_in_flight",  "dram_bytes_per_cycle", "fetch_latency",
-                          "cache_hit_latency", "cache_ways",      "unit_cycle_scale",     "box_cycles",
+                          "cache_hit_latency", "cache_ways",      "unit_cycle_scale",     "issue_width", "box_cycles",
                           "tri_cycles",       "dram_pj_per_byte", "sram_pj_per_word",     "add_pj_per_bit",
                           "mul_pj_per_pp_bit"};
     const double vals[] = {tp->clock_mhz,        tp->rays_in_flight,   tp->dram_bytes_per_cycle, tp->fetch_latency,
-                           tp->cache_hit_latency, tp->cache_ways,       tp->unit_cycle_scale,     tp->box_cycles,
+                           tp->cache_hit_latency, tp->cache_ways,       tp->unit_cycle_scale,     tp->issue_width, tp->box_cycles,
                            tp->tri_cycles,        tp->dram_pj_per_byte, tp->sram_pj_per_word,     tp->add_pj_per_bit,
                            tp->mul_pj_per_pp_bit};
     for (size_t i = 0; i < sizeof vals / sizeof vals[0]; i++)
@@ -109,7 +109,8 @@ void cbvh_best_sentence(char *out, size_t n, const char *scene, const char *best
 void cbvh_machine_line(const cbvh_timing_params *tp, char *out, size_t n) {
     snprintf(out, n,
              "%g rays in flight, %g MHz; cache %g-way, %g-cycle hit; DRAM %g cycles, %g B/cycle; units from the "
-             "RTL cost table (cycles x %g)",
+             "RTL cost table (cycles x %g), %g operation%s per cycle each%s",
              tp->rays_in_flight, tp->clock_mhz, tp->cache_ways, tp->cache_hit_latency, tp->fetch_latency,
-             tp->dram_bytes_per_cycle, tp->unit_cycle_scale);
+             tp->dram_bytes_per_cycle, tp->unit_cycle_scale, tp->issue_width, tp->issue_width == 1 ? "" : "s",
+             isnan(tp->box_cycles) && isnan(tp->tri_cycles) ? "" : " (box/triangle cycles set)");
 }

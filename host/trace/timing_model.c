@@ -15,6 +15,7 @@ void cbvh_timing_defaults(cbvh_timing_params *p) {
     p->cache_hit_latency = 4.0;       /* assumption: a 4-cycle L1-style load-to-use latency */
     p->cache_ways = 8.0;              /* assumption */
     p->unit_cycle_scale = 1.0;        /* the RTL's cycle counts at the model clock (docs/timing_model.md §2) */
+    p->issue_width = 1.0;             /* assumption: one operation per cycle per unit type */
     p->box_cycles = p->tri_cycles = NAN; /* from the cost table */
     p->dram_pj_per_byte = 1300.0 / 8; /* Horowitz ISSCC 2014 (45 nm): DRAM 1.3-2.6 nJ per 64-bit access, low end */
     p->sram_pj_per_word = 10.0;       /* Horowitz ISSCC 2014: 64-bit read from an 8 KB SRAM, 10 pJ */
@@ -33,6 +34,7 @@ int cbvh_timing_set(cbvh_timing_params *p, const char *spec, char *err, size_t e
              {"cache_hit_latency", &p->cache_hit_latency},
              {"cache_ways", &p->cache_ways},
              {"unit_cycle_scale", &p->unit_cycle_scale},
+             {"issue_width", &p->issue_width},
              {"box_cycles", &p->box_cycles},
              {"tri_cycles", &p->tri_cycles},
              {"dram_pj_per_byte", &p->dram_pj_per_byte},
@@ -87,6 +89,10 @@ int cbvh_timing_check(const cbvh_timing_params *p, char *err, size_t errlen) {
                      CBVH_TIMING_MAX);
             return -1;
         }
+    if (bad(p->issue_width, 1) || p->issue_width > 1024 || p->issue_width != floor(p->issue_width)) {
+        snprintf(err, errlen, "timing.issue_width: %g is not a whole number in [1, 1024]", p->issue_width);
+        return -1;
+    }
     if (bad(p->cache_ways, 1) || p->cache_ways > 64 || p->cache_ways != floor(p->cache_ways)) {
         snprintf(err, errlen, "timing.cache_ways: %g is not a whole number in [1, 64]", p->cache_ways);
         return -1;
@@ -106,16 +112,16 @@ static void unit_from(const cbvh_timing_params *p, const cbvh_cost_row *r, cbvh_
     snprintf(u->unit, sizeof u->unit, "%s", r->unit);
     u->latency = r->latency * p->unit_cycle_scale;
     u->ii = r->ii * p->unit_cycle_scale;
-    u->instances = ceil(u->ii - 1e-9);
-    if (u->instances < 1) u->instances = 1;
+    u->instances = ceil(u->ii * p->issue_width - 1e-9);
+    if (u->instances < p->issue_width) u->instances = p->issue_width;
     u->lut4 = r->lut4;
     u->energy_pj = r->pp_bits * p->mul_pj_per_pp_bit + r->adder_bits * p->add_pj_per_bit;
 }
 
-/* v1's pipelined unit: latency = II = cycles, one instance. */
-static void unit_cycles(cbvh_unit_cost *u, double cycles) {
+/* v1's pipelined unit: latency = II = cycles, one instance (issue_width of them). */
+static void unit_cycles(cbvh_unit_cost *u, double cycles, double width) {
     u->latency = u->ii = cycles;
-    u->instances = 1;
+    u->instances = width;
 }
 
 static int lookup(const cbvh_cost_table *t, const cbvh_timing_params *p, const char *unit, int n, int m,
@@ -137,8 +143,9 @@ int cbvh_timing_units_for(const cbvh_cost_table *t, const cbvh_timing_params *p,
         (dec && lookup(t, p, "nodepair_decoder", n, m, &u->dec, err, errlen)) ||
         (qstack && lookup(t, p, "qbvh_stack", n, m, &u->qstack, err, errlen)))
         return -1;
-    if (!isnan(p->box_cycles) && strcmp(node_unit, "ray_sphere") != 0) unit_cycles(&u->node, p->box_cycles);
-    if (!isnan(p->tri_cycles)) unit_cycles(&u->tri, p->tri_cycles);
+    if (!isnan(p->box_cycles) && strcmp(node_unit, "ray_sphere") != 0)
+        unit_cycles(&u->node, p->box_cycles, p->issue_width);
+    if (!isnan(p->tri_cycles)) unit_cycles(&u->tri, p->tri_cycles, p->issue_width);
     return 0;
 }
 

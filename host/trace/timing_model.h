@@ -22,6 +22,7 @@ typedef struct {
     double cache_hit_latency;    /* cycles from request to data on a hit (a cache present) */
     double cache_ways;           /* associativity */
     double unit_cycle_scale;     /* model cycles per RTL cycle of a unit (1: the RTL's pipeline at the model clock) */
+    double issue_width;          /* operations each unit type can start per cycle (instances = ceil(II x width)) */
     double box_cycles, tri_cycles; /* NaN: the cost table; else that unit's latency and II, one instance */
     double dram_pj_per_byte;     /* DRAM energy per byte moved */
     double sram_pj_per_word;     /* cache energy per 64-bit word read at 8 KB (x sqrt(size / 8 KB)) */
@@ -31,6 +32,7 @@ typedef struct {
 
 /* Ranges: every parameter <= CBVH_TIMING_MAX; latencies and energies >= 0;
  * clock, bandwidth, rays in flight, cycle scale >= CBVH_TIMING_RATE_MIN;
+ * issue width a whole number 1..1024;
  * ways 1..64 (whole); box/tri_cycles NaN or >= 0. */
 #define CBVH_TIMING_MAX 1e9
 #define CBVH_TIMING_RATE_MIN 1e-3
@@ -39,7 +41,7 @@ void cbvh_timing_defaults(cbvh_timing_params *p);
 
 /* Overrides "key=value[,key=value...]" with the scene file's timing keys
  * (docs/scenes.md): clock_mhz, rays_in_flight, dram_bytes_per_cycle,
- * fetch_latency, cache_hit_latency, cache_ways, unit_cycle_scale,
+ * fetch_latency, cache_hit_latency, cache_ways, unit_cycle_scale, issue_width,
  * box_cycles, tri_cycles, dram_pj_per_byte, sram_pj_per_word.  0, or -1
  * with a one-line reason (unknown key, not a number); the ranges are
  * cbvh_timing_check's. */
@@ -52,7 +54,7 @@ typedef struct {
     int present;      /* 0: the format does not use it */
     double latency;   /* cycles from an operation's input to its result */
     double ii;        /* cycles between operations on one instance */
-    double instances; /* ceil(II): enough copies to start one operation per cycle */
+    double instances; /* ceil(II x issue_width): enough copies to start issue_width operations per cycle */
     double lut4;      /* area of one instance (iCE40 4-input LUTs) */
     double energy_pj; /* per operation (ASIC widths x per-bit energies) */
     char unit[CBVH_COST_UNIT_MAX];

@@ -124,6 +124,12 @@ static void units_from_table(void **state) {
     assert_float_equal(u.node.energy_pj, 3.1 + 1.0, 1e-12);
     assert_float_equal(u.tri.ii, 5, 0);
     assert_float_equal(u.tri.instances, 5, 0);
+    /* Four operations per cycle: four times the instances. */
+    p.issue_width = 4;
+    assert_int_equal(cbvh_timing_units_for(&t, &p, "ray_box_incr", 0, 0, 8, 8, &u, err, sizeof err), 0);
+    assert_float_equal(u.node.instances, 16, 0); /* ceil(4 x 4) */
+    assert_float_equal(u.tri.instances, 20, 0);  /* 5 x 4 */
+    p.issue_width = 1;
     /* The v1 override: latency = II = cycles, one instance. */
     p.box_cycles = 3;
     assert_int_equal(cbvh_timing_units_for(&t, &p, "ray_box", 0, 0, 6, 24, &u, err, sizeof err), 0);
