@@ -65,7 +65,7 @@ static void usage(FILE *f) {
             "  --timing K=V,...  timing-model parameters over the scene file's (its timing keys,\n"
             "                    docs/scenes.md), e.g. rays_in_flight=256,box_cycles=1,tri_cycles=1\n"
             "  --json            machine-readable output on stdout\n"
-            "  A list option (--mant, --min-scale, --heatmap, --formats) may be given once; any other\n"
+            "  A list option (--mant, --min-scale, --heatmap, --formats, --cache) may be given once; any other\n"
             "  option given twice: the last wins.\n"
             "testing:\n"
             "  --test-corrupt S:R  pretend setting S (index in trace order) returned a wrong answer for\n"
