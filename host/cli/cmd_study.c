@@ -14,6 +14,7 @@
 #include "cli/data_dir.h"
 #include "util/parse_int.h"
 #include "scene/scene_load.h"
+#include "trace/timing_model.h"
 
 /* Sec. 5.2 memory-traffic model (bytes). */
 enum {
@@ -40,7 +41,33 @@ typedef struct {
     double mem_refit[NCFG + 1];
     uint64_t hist_rel[8], hist_mod[8]; /* re-encodes by depth 1..7+ (LBVH) */
     const char *deform;
+    double pair_bytes;
+    /* Build and refit time under the timing model's DRAM (ms): LBVH {float,
+     * float + top-down, bottom-up relative, bottom-up modulo + 4-level
+     * treelets}; refit {float, float + top-down, bottom-up M4}. */
+    double t_lbvh[4], t_refit[3];
 } scene_result;
+
+enum { BT_RNONE = 0, BT_M4 = 7 }; /* cfg_name indices: R-, M4 */
+
+/* Seed 003 Sec. 5.2's traffic as time (docs/timing_model.md §7): every pass
+ * streams its bytes at the DRAM bandwidth; the backtracking unit's steps
+ * run one after another, each a DRAM round trip. */
+static void build_times(scene_result *r, const cbvh_timing_params *tp) {
+    double n = r->tris, P = r->pairs, pb = r->pair_bytes, ms = 1e-3 / tp->clock_mhz; /* cycles -> ms */
+    double common = (TR_INPUT + TR_SORT + TR_ID) * n;
+    double flt = common + TR_FLOAT_PAIR * P; /* the float LBVH writes its hierarchy */
+    r->t_lbvh[0] = cbvh_build_cycles(tp, flt, 0) * ms;
+    r->t_lbvh[1] = cbvh_build_cycles(tp, flt + TR_FLOAT_PAIR * P + pb * P, 0) * ms; /* read it back, write the CBVH */
+    for (int k = 0; k < 2; k++) {
+        double bt = (double)r->bt_lbvh[k ? BT_M4 : BT_RNONE];
+        r->t_lbvh[2 + k] = cbvh_build_cycles(tp, common + pb * P + TR_BACKTRACK * bt, bt) * ms;
+    }
+    double rcommon = (TR_ID + TR_INPUT) * n, bt = (double)r->bt_refit[BT_M4];
+    r->t_refit[0] = cbvh_build_cycles(tp, rcommon + 2.0 * TR_FLOAT_PAIR * P, 0) * ms;
+    r->t_refit[1] = cbvh_build_cycles(tp, rcommon + 3.0 * TR_FLOAT_PAIR * P + pb * P, 0) * ms;
+    r->t_refit[2] = cbvh_build_cycles(tp, rcommon + 2.0 * pb * P + TR_BACKTRACK * bt, bt) * ms;
+}
 
 static double traffic_lbvh(double n, double pairs, double pair_bytes, double bt, int topdown) {
     double common = TR_INPUT * n + TR_SORT * n + TR_ID * n;
@@ -134,6 +161,7 @@ static int study_scene(const char *spec, cbvh_params p, scene_result *r, char *e
     r->cbvh_bytes = cbvh_tree_bytes(&td);
     r->bvh_bytes = cbvh_bvh_bytes(&b);
     double pb = (double)td.pair_bytes;
+    r->pair_bytes = pb;
     cbvh_tree_free(&td);
     if (cbvh_build_sah(&s, 0, 0, &sah, err, errlen) == 0) {
         if (cbvh_compress_topdown(&sah, &o, &td, err, errlen) == 0) {
@@ -227,7 +255,8 @@ static cJSON *json_counts(const uint64_t *v, int n) {
     return a;
 }
 
-static void json_write(const scene_result *res, const sweep_result *sw, int ns, int sweep, cbvh_params p) {
+static void json_write(const scene_result *res, const sweep_result *sw, int ns, int sweep, cbvh_params p,
+                       const cbvh_timing_params *tp) {
     cJSON *root = cJSON_CreateObject();
     cJSON_AddNumberToObject(root, "quant_bits", p.quant_bits);
     cJSON_AddNumberToObject(root, "min_scale", p.min_scale);
@@ -238,6 +267,18 @@ static void json_write(const scene_result *res, const sweep_result *sw, int ns, 
     cJSON_AddNumberToObject(tm, "float_pair", TR_FLOAT_PAIR);
     cJSON_AddNumberToObject(tm, "id", TR_ID);
     cJSON_AddNumberToObject(tm, "backtrack", TR_BACKTRACK);
+    cJSON *bm = cJSON_AddObjectToObject(root, "build_time_model");
+    cJSON_AddItemToObject(bm, "lbvh", cJSON_CreateStringArray((const char *const[]){"float", "float+topdown",
+                                                                                     "bottomup_relative",
+                                                                                     "bottomup_modulo_treelets4"},
+                                                               4));
+    cJSON_AddItemToObject(bm, "refit",
+                          cJSON_CreateStringArray((const char *const[]){"float", "float+topdown",
+                                                                        "bottomup_modulo_treelets4"},
+                                                  3));
+    cJSON_AddNumberToObject(bm, "dram_bytes_per_cycle", tp->dram_bytes_per_cycle);
+    cJSON_AddNumberToObject(bm, "fetch_latency", tp->fetch_latency);
+    cJSON_AddNumberToObject(bm, "clock_mhz", tp->clock_mhz);
     cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
     for (int i = 0; i < ns; i++) {
         const scene_result *r = &res[i];
@@ -259,6 +300,9 @@ static void json_write(const scene_result *res, const sweep_result *sw, int ns, 
         cJSON_AddItemToObject(o, "backtracks_norm", json_arr(r->norm_bt, NCFG));
         cJSON_AddItemToObject(o, "traffic_lbvh_norm", json_arr(r->mem_lbvh, NCFG + 1));
         cJSON_AddItemToObject(o, "traffic_refit_norm", json_arr(r->mem_refit, NCFG + 1));
+        cJSON *bt = cJSON_AddObjectToObject(o, "build_time_ms");
+        cJSON_AddItemToObject(bt, "lbvh", json_arr(r->t_lbvh, 4));
+        cJSON_AddItemToObject(bt, "refit", json_arr(r->t_refit, 3));
         if (sweep) {
             cJSON *j = cJSON_AddObjectToObject(o, "sweep");
             cJSON_AddItemToObject(j, "min_scale", cJSON_CreateIntArray(sweep_scales, NSWEEP));
@@ -315,12 +359,15 @@ static void print_block(const char *title, const scene_result *r, int nr, size_t
 
 static void usage(FILE *f) {
     fprintf(f, "usage: cbvh study [SCENE...] [--json] [--quant-bits N] [--min-scale E] [--no-sweep]\n"
+               "                  [--timing K=V,...]\n"
                "  SCENE: a mesh file (OBJ, PLY, OFF, STL, glTF/GLB) or proc:cloth, proc:far, proc:wave,\n"
                "         proc:instanced[:K] (K x K spheres, 40 -> 10.2M triangles); default: the bundled\n"
                "         bunny plus proc:cloth, proc:far, proc:wave.\n"
                "  Prints the Table-1-style study (backtracking, memory traffic of LBVH and refit,\n"
                "  SAH cost, primitives per leaf) and the minimum-scale sweep of Fig. 10 (docs/study.md).\n"
                "  --quant-bits N  coordinate bits, %d..%d (default 6); --min-scale E  %d..%d (default %d)\n"
+               "  --timing K=V,...  the DRAM of the build and refit times (docs/timing_model.md §7):\n"
+               "                  dram_bytes_per_cycle, fetch_latency, clock_mhz (default 12.8, 100, 1000)\n"
                "  Exit status: 0 done, 2 bad input (an option, or a scene that cannot be loaded or built).\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
 }
@@ -329,7 +376,36 @@ typedef struct {
     const char **specs; /* argc + 4 entries */
     int ns, json, sweep;
     cbvh_params p;
+    cbvh_timing_params tp; /* the DRAM of the build times */
 } study_opts;
+
+/* The build and refit times beside seed 003's Table 2 / Fig. 11. */
+static void print_build_times(const scene_result *r, int nr, const cbvh_timing_params *tp) {
+    printf("\nBuild and refit time under the timing model's DRAM (%g B/cycle, %g-cycle latency, %g MHz; "
+           "docs/timing_model.md §7), ms, and x the float LBVH (x the float refit):\n",
+           tp->dram_bytes_per_cycle, tp->fetch_latency, tp->clock_mhz);
+    printf("%-26s %9s %15s %15s %15s | %9s %15s %15s\n", "scene", "float", "float + TD", "BU relative",
+           "BU mod+treelet4", "refit", "float + TD", "BU mod+treelet4");
+    double sum[6] = {0}, sum_vs_td = 0;
+    for (int i = 0; i < nr; i++) {
+        const double *l = r[i].t_lbvh, *f = r[i].t_refit;
+        printf("%-26.26s %9.4f %8.4f x%5.3f %8.4f x%5.3f %8.4f x%5.3f | %9.4f %8.4f x%5.3f %8.4f x%5.3f\n",
+               r[i].name, l[0], l[1], l[1] / l[0], l[2], l[2] / l[0], l[3], l[3] / l[0], f[0], f[1], f[1] / f[0],
+               f[2], f[2] / f[0]);
+        for (int k = 0; k < 3; k++) sum[k] += l[k + 1] / l[0];
+        for (int k = 0; k < 2; k++) sum[3 + k] += f[k + 1] / f[0];
+        sum_vs_td += l[3] / l[1];
+    }
+    if (!nr) return;
+    printf("%-26s %9s %15s %15s %15s | %9s %15s %15s\n", "avg x float", "", "", "", "", "", "", "");
+    printf("%-26s %9s %+14.0f%% %+14.0f%% %+14.0f%% | %9s %+14.0f%% %+14.0f%%\n", "  ours", "",
+           100 * (sum[0] / nr - 1), 100 * (sum[1] / nr - 1), 100 * (sum[2] / nr - 1), "", 100 * (sum[3] / nr - 1),
+           100 * (sum[4] / nr - 1));
+    printf("%-26s %9s %15s %15s %15s | %9s\n", "  paper (Table 2, Fig. 11)", "", "+36%", "+52%", "-20%",
+           "(no refit runtime in the paper)");
+    printf("BU modulo + treelets 4 against float + top-down: ours %+.0f %%, paper -41 %%\n",
+           100 * (sum_vs_td / nr - 1));
+}
 
 /* --quant-bits / --min-scale: one line naming the option and the value (not
  * the usage).  0 or -1. */
@@ -351,7 +427,7 @@ static int parse_param(const char *opt, const char *val, long lo, long hi, int *
     return 0;
 }
 
-enum { OPT_JSON = 256, OPT_NO_SWEEP, OPT_QUANT_BITS, OPT_MIN_SCALE };
+enum { OPT_JSON = 256, OPT_NO_SWEEP, OPT_QUANT_BITS, OPT_MIN_SCALE, OPT_TIMING };
 
 /* --quant-bits or --min-scale (opt) with its value (NULL: missing). */
 static int set_param(int opt, const char *val, cbvh_params *p) {
@@ -366,6 +442,7 @@ static int parse_options(int argc, char **argv, study_opts *o) {
                                        {"no-sweep", no_argument, 0, OPT_NO_SWEEP},
                                        {"quant-bits", required_argument, 0, OPT_QUANT_BITS},
                                        {"min-scale", required_argument, 0, OPT_MIN_SCALE},
+                                       {"timing", required_argument, 0, OPT_TIMING},
                                        {0, 0, 0, 0}};
     int c;
     optind = 0;
@@ -377,11 +454,23 @@ static int parse_options(int argc, char **argv, study_opts *o) {
         case 'h': usage(stdout); return 1;
         case OPT_JSON: o->json = 1; break;
         case OPT_NO_SWEEP: o->sweep = 0; break;
+        case OPT_TIMING: {
+            char err[200];
+            if (cbvh_timing_set(&o->tp, optarg, err, sizeof err)) {
+                fprintf(stderr, "cbvh study: %s\n", err);
+                return 2;
+            }
+            break;
+        }
         case OPT_QUANT_BITS:
         case OPT_MIN_SCALE:
             if (set_param(c, optarg, &o->p)) return 2;
             break;
-        case ':': /* only the two options above take a value */
+        case ':': /* only the three options above take a value */
+            if (optopt == OPT_TIMING) {
+                fprintf(stderr, "cbvh study: --timing needs key=value[,key=value...]\n");
+                return 2;
+            }
             if (set_param(optopt, NULL, &o->p)) return 2;
             break;
         default: return cbvh_unknown_option("cbvh study", argv, optind);
@@ -395,7 +484,9 @@ int cmd_study(int argc, char **argv) {
     char bunny[PATH_MAX];
     snprintf(bunny, sizeof bunny, "%s/scenes/bunny-small.obj", cbvh_data_dir());
     const char *defaults[] = {bunny, "proc:cloth", "proc:far", "proc:wave"};
-    study_opts o = {malloc((size_t)(argc + 4) * sizeof *o.specs), 0, 0, 1, {6, CBVH_MIN_SCALE_DEFAULT}};
+    study_opts o = {.specs = malloc((size_t)(argc + 4) * sizeof *o.specs), .sweep = 1,
+                    .p = {6, CBVH_MIN_SCALE_DEFAULT}};
+    cbvh_timing_defaults(&o.tp);
     if (!o.specs) cbvh_out_of_memory("scene list");
     int rc = parse_options(argc, argv, &o);
     if (rc) {
@@ -419,9 +510,10 @@ int cmd_study(int argc, char **argv) {
             status = 2; /* bad input, as for the other commands */
             goto done;
         }
+        build_times(&res[i], &o.tp);
     }
     if (json) {
-        json_write(res, sw, ns, sweep, p);
+        json_write(res, sw, ns, sweep, p, &o.tp);
         goto done;
     }
     printf("cbvh study: N = %d, min scale 2^%d, LBVH (30-bit Morton, equal codes share a leaf)\n", p.quant_bits,
@@ -439,6 +531,7 @@ int cmd_study(int argc, char **argv) {
                 NCFG + 1, 1);
     print_block("Memory traffic (refit), normalized to top-down (TD)", res, ns, offsetof(scene_result, mem_refit),
                 NCFG + 1, 1);
+    print_build_times(res, ns, &o.tp);
     printf("\nRaw backtrack iterations (LBVH | refit):\n");
     for (int i = 0; i < ns; i++) {
         printf("%-26.26s", res[i].name);

@@ -18,17 +18,22 @@
 #include "cbvh/oom.h"
 #include "util/chart_svg.h"
 #include "cli/commands.h"
+#include "cli/data_dir.h"
 #include "util/image_png.h"
 #include "util/parse_int.h"
+#include "trace/cost_table.h"
+#include "trace/model_eval.h"
 #include "trace/sweep.h"
 
 #define MAX_HEAT 16
+#define MAX_FILES 64
 
 static void usage(FILE *f) {
     fprintf(f,
             "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
             "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,F...]]\n"
-            "                        [--one-sided]\n"
+            "                        [--one-sided] [--cache KB...] [--reps K] [--cost-table DIR]\n"
+            "                        [--timing K=V,...]\n"
             "  SCENE is a scene file (.scene, .json) or a mesh file / proc:NAME (its default scene,\n"
             "  docs/scenes.md).\n"
             "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
@@ -51,13 +56,22 @@ static void usage(FILE *f) {
             "                    bounding-sphere hierarchy, docs/tlist.md; default 6 lists, earliest first)\n"
             "  --one-sided       triangles count only from their front side (counter-clockwise), on every\n"
             "                    format; needed by tlist:...:cull (back-face culling)\n"
+            "  --cache KB...     node and triangle cache sizes the timing model runs, each in KB (0 = no\n"
+            "                    cache, inf = infinite), at most %d (default 64; docs/timing_model.md)\n"
+            "  --reps K          timed repetitions for the CPU-time column, 1..%d (default 5): the median\n"
+            "                    and the fastest and slowest are printed\n"
+            "  --cost-table DIR  the RTL cost table, one JSON file per unit (default: gateware/cost\n"
+            "                    beside the committed vectors)\n"
+            "  --timing K=V,...  timing-model parameters over the scene file's (its timing keys,\n"
+            "                    docs/scenes.md), e.g. rays_in_flight=256,box_cycles=1,tri_cycles=1\n"
             "  --json            machine-readable output on stdout\n"
-            "  A list option (--mant, --min-scale, --heatmap, --formats) may be given once; any other\n"
+            "  A list option (--mant, --min-scale, --heatmap, --formats, --cache) may be given once; any other\n"
             "  option given twice: the last wins.\n"
             "testing:\n"
             "  --test-corrupt S:R  pretend setting S (index in trace order) returned a wrong answer for\n"
             "                      ray R, to show the identity check fails (docs/sweep.md)\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT, CBVH_CACHES_MAX,
+            CBVH_REPS_MAX);
 }
 
 
@@ -174,10 +188,19 @@ static int parse_heat(const char *s, heat_spec *h) {
     return 0;
 }
 
-static void progress(void *ctx, const char *label, int setting, int settings, int row, int rows) {
-    (void)ctx;
+/* What the progress line needs to know. */
+typedef struct {
+    int reps;
+} sweep_cli_reps;
+
+static void progress(void *ctx, const char *label, int setting, int settings, int row, int rows, int rep) {
+    const sweep_cli_reps *r = ctx;
     if (row % 8 && row != rows - 1) return;
-    fprintf(stderr, "\rsweep %d/%d %-18s row %d/%d   ", setting, settings, label, row + 1, rows);
+    if (rep)
+        fprintf(stderr, "\rtiming %d/%d %d/%d %-18s row %d/%d   ", rep, r->reps, setting, settings, label, row + 1,
+                rows);
+    else
+        fprintf(stderr, "\rsweep %d/%d %-18s row %d/%d   ", setting, settings, label, row + 1, rows);
 }
 
 /* "sweep-" + the scene file's name without directory and extension. */
@@ -191,9 +214,9 @@ static void default_out(const char *scene, char *out, size_t n) {
 
 
 static const char *metric_names[SWEEP_NMETRICS] = {"box tests", "triangle tests", "bytes", "modelled time",
-                                                  "CPU time"};
+                                                  "CPU time", "modelled energy"};
 static const char *metric_keys[SWEEP_NMETRICS] = {"box_per_ray", "tri_per_ray", "bytes_per_ray", "model_ns_per_ray",
-                                                 "cpu_us_per_ray"};
+                                                 "cpu_us_per_ray", "energy_nj_per_ray"};
 
 static void print_rel(double r) {
     if (isnan(r))
@@ -223,10 +246,10 @@ static void json_rel(cJSON *o, const char *key, double r) {
 }
 
 static void text_row(const char *setting, const char *effect, const cbvh_fx_stats *s, const cbvh_fx_stats *f,
-                     uint64_t mem, uint64_t fmem, const cbvh_timing_params *tp, const char *same) {
+                     uint64_t mem, uint64_t fmem, const cbvh_machine *ms, const cbvh_machine *mf, const char *same) {
     double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
-    cbvh_sweep_per_ray(s, tp, p);
-    cbvh_sweep_per_ray(f, tp, q);
+    cbvh_sweep_per_ray(s, ms, p);
+    cbvh_sweep_per_ray(f, mf, q);
     printf("%-28s %-17s %8llu %8.2f %7.2f %8.1f %9.1f %7.2f |", setting, effect, (unsigned long long)s->rays,
            p[SWEEP_BOX], p[SWEEP_TRI], p[SWEEP_BYTES], p[SWEEP_MODEL_NS], p[SWEEP_CPU_US]);
     print_rel(cbvh_ratio(p[SWEEP_BOX], q[SWEEP_BOX]));
@@ -234,24 +257,51 @@ static void text_row(const char *setting, const char *effect, const cbvh_fx_stat
     print_rel(cbvh_ratio(p[SWEEP_BYTES], q[SWEEP_BYTES]));
     print_rel(cbvh_ratio((double)mem, (double)fmem));
     print_rel(cbvh_ratio(p[SWEEP_MODEL_NS], q[SWEEP_MODEL_NS]));
-    print_rel(cbvh_ratio(p[SWEEP_CPU_US], q[SWEEP_CPU_US]));
+    print_rel(cbvh_fx_cpu_ratio(s, f));
     printf("  %s\n", same);
 }
 
+/* One set of rays' costs (per effect or total) against the float BVH's on the
+ * same rays: the counters, and the timing model at every cache size of the
+ * run (ms: the configuration's machines, mf: the float BVH's). */
 static cJSON *json_costs(const cbvh_fx_stats *s, const cbvh_fx_stats *f, uint64_t mem, uint64_t fmem,
-                         const cbvh_timing_params *tp) {
+                         const cbvh_config_model *ms, const cbvh_config_model *mf) {
     double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
-    cbvh_sweep_per_ray(s, tp, p);
-    cbvh_sweep_per_ray(f, tp, q);
+    cbvh_sweep_per_ray(s, &ms->mc[0], p);
+    cbvh_sweep_per_ray(f, &mf->mc[0], q);
     cJSON *o = cJSON_CreateObject();
     cJSON_AddNumberToObject(o, "rays", (double)s->rays);
     cJSON_AddNumberToObject(o, "hits", (double)s->hits);
     cJSON_AddNumberToObject(o, "max_stack", s->st.max_stack);
     for (int m = 0; m < SWEEP_NMETRICS; m++) cJSON_AddNumberToObject(o, metric_keys[m], p[m]);
+    cbvh_ray_metrics cm;
+    cbvh_ray_metrics_of(s, &ms->mc[0], &cm);
+    cJSON_AddNumberToObject(o, "cpu_us_per_ray_min", cm.cpu_lo);
+    cJSON_AddNumberToObject(o, "cpu_us_per_ray_max", cm.cpu_hi);
+    cJSON_AddNumberToObject(o, "cpu_reps", s->nreps);
     cJSON *r = cJSON_AddObjectToObject(o, "relative_to_float");
-    static const char *rk[SWEEP_NMETRICS] = {"box_tests", "tri_tests", "bytes", "model_time", "cpu_time"};
-    for (int m = 0; m < SWEEP_NMETRICS; m++) json_rel(r, rk[m], cbvh_ratio(p[m], q[m]));
+    static const char *rk[SWEEP_NMETRICS] = {"box_tests", "tri_tests", "bytes", "model_time", "cpu_time", "energy"};
+    for (int m = 0; m < SWEEP_NMETRICS; m++)
+        json_rel(r, rk[m], m == SWEEP_CPU_US ? cbvh_fx_cpu_ratio(s, f) : cbvh_ratio(p[m], q[m]));
     json_rel(r, "node_memory", cbvh_ratio((double)mem, (double)fmem));
+    cJSON *model = cJSON_AddArrayToObject(o, "model");
+    for (int c = 0; c < ms->ncaches; c++) {
+        cbvh_ray_metrics a, b;
+        cbvh_ray_metrics_of(s, &ms->mc[c], &a);
+        cbvh_ray_metrics_of(f, &mf->mc[c], &b);
+        cJSON *mo = cJSON_CreateObject();
+        cJSON_AddItemToArray(model, mo);
+        json_rel(mo, "cache_kb", ms->mc[c].cache_kb); /* null: infinite */
+        cJSON_AddNumberToObject(mo, "ns_per_ray", a.model_ns);
+        cbvh_model_json(mo, &a);
+        cJSON_AddNumberToObject(mo, "false_positive_box_hits_per_ray", 0); /* the exact unit: none (issue 35) */
+        cJSON_AddNumberToObject(mo, "extra_tri_tests_per_ray", 0);
+        cJSON *mr = cJSON_AddObjectToObject(mo, "relative_to_float");
+        json_rel(mr, "time", cbvh_ratio(a.model_ns, b.model_ns));
+        json_rel(mr, "energy", cbvh_ratio(a.energy_nj, b.energy_nj));
+        json_rel(mr, "area", cbvh_ratio(a.area_lut4, b.area_lut4));
+        json_rel(mr, "dram_bytes", cbvh_ratio(a.dram_bytes, b.dram_bytes));
+    }
     return o;
 }
 
@@ -317,7 +367,9 @@ typedef struct {
     long knee_pct;
     heat_spec heat[MAX_HEAT];
     int nheat;
-    int mant_given, ms_given, heat_given, formats_given; /* list options: once each */
+    int mant_given, ms_given, heat_given, formats_given, cache_given; /* list options: once each */
+    const char *cost_dir, *timing;
+    sweep_cli_reps reps;
 } sweep_cli;
 
 enum {
@@ -331,6 +383,10 @@ enum {
     OPT_HEATMAP,
     OPT_ONE_SIDED,
     OPT_FORMATS,
+    OPT_CACHE,
+    OPT_REPS,
+    OPT_COST_TABLE,
+    OPT_TIMING,
     OPT_TEST_CORRUPT
 };
 
@@ -426,6 +482,47 @@ static int parse_formats(const char *v, cbvh_sweep_opts *o) {
     return 0;
 }
 
+/* "64", "0,16,inf": a value of --cache (else the next option or the scene). */
+static int is_cache_list(const char *s) {
+    if (has_empty_item(s)) return 0;
+    for (const char *t = s; t; t = strchr(t, ',') ? strchr(t, ',') + 1 : NULL) {
+        size_t n = strcspn(t, ",");
+        if (!is_int(t, n) && !(n == 3 && strncmp(t, "inf", 3) == 0)) return 0;
+    }
+    return 1;
+}
+
+/* --cache's sizes: first, then the following arguments that are cache lists. */
+static int parse_caches(const char *first, int argc, char **argv, cbvh_sweep_opts *o) {
+    if (!is_cache_list(first)) {
+        fprintf(stderr, "cbvh sweep: --cache expects sizes in KB (0..%d, or inf), got '%s'\n", CBVH_CACHE_KB_MAX,
+                first);
+        return -1;
+    }
+    for (const char *a = first; a; a = optind < argc && is_cache_list(argv[optind]) ? argv[optind++] : NULL)
+        for (const char *t = a; t; t = strchr(t, ',') ? strchr(t, ',') + 1 : NULL) {
+            char item[32];
+            size_t len = strcspn(t, ",");
+            double kb;
+            if (len >= sizeof item || (memcpy(item, t, len), item[len] = 0, cbvh_cache_kb_parse(item, &kb))) {
+                fprintf(stderr, "cbvh sweep: --cache expects sizes in KB (0..%d, or inf), got '%.*s'\n",
+                        CBVH_CACHE_KB_MAX, (int)len, t);
+                return -1;
+            }
+            if (o->ncaches == CBVH_CACHES_MAX) {
+                fprintf(stderr, "cbvh sweep: --cache takes at most %d sizes\n", CBVH_CACHES_MAX);
+                return -1;
+            }
+            for (int k = 0; k < o->ncaches; k++)
+                if (o->cache_kb[k] == kb) {
+                    fprintf(stderr, "cbvh sweep: --cache: %s given twice\n", item);
+                    return -1;
+                }
+            o->cache_kb[o->ncaches++] = kb;
+        }
+    return 0;
+}
+
 /* Test hook (docs/sweep.md): SETTING_INDEX:RAY_INDEX. */
 static int parse_corrupt(const char *v, cbvh_sweep_opts *o) {
     long si, ri;
@@ -447,6 +544,16 @@ static int set_scene(sweep_cli *c, const char *a) {
         return -1;
     }
     c->scene = a;
+    return 0;
+}
+
+/* An option naming a directory: not empty.  0 or -1. */
+static int directory(const char *opt, const char *v, const char **dst) {
+    if (!v[0]) {
+        fprintf(stderr, "cbvh sweep: %s expects a directory\n", opt);
+        return -1;
+    }
+    *dst = v;
     return 0;
 }
 
@@ -479,19 +586,27 @@ static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli
             return -1;
         }
         return 0;
-    case OPT_OUT:
-        if (!v[0]) {
-            fprintf(stderr, "cbvh sweep: --out expects a directory\n");
-            return -1;
-        }
-        c->outdir = v;
-        return 0;
+    case OPT_OUT: return directory("--out", v, &c->outdir);
     case OPT_HEATMAP:
         if (list_again("--heatmap", &c->heat_given)) return -1;
         return parse_heatmaps(v, argc, argv, c);
     case OPT_FORMATS:
         if (list_again("--formats", &c->formats_given)) return -1;
         return parse_formats(v, o);
+    case OPT_CACHE:
+        if (list_again("--cache", &c->cache_given)) return -1;
+        return parse_caches(v, argc, argv, o);
+    case OPT_REPS:
+        if (cbvh_parse_long(v, 1, CBVH_REPS_MAX, &n)) {
+            fprintf(stderr, "cbvh sweep: --reps expects an integer in 1..%d, got '%s'\n", CBVH_REPS_MAX, v);
+            return -1;
+        }
+        o->reps = (int)n;
+        return 0;
+    case OPT_TIMING:
+        c->timing = v;
+        return 0;
+    case OPT_COST_TABLE: return directory("--cost-table", v, &c->cost_dir);
     default: /* OPT_TEST_CORRUPT */
         return parse_corrupt(v, o);
     }
@@ -510,10 +625,15 @@ static int parse_options(int argc, char **argv, sweep_cli *c) {
                                        {"heatmap", required_argument, 0, OPT_HEATMAP},
                                        {"one-sided", no_argument, 0, OPT_ONE_SIDED},
                                        {"formats", required_argument, 0, OPT_FORMATS},
+                                       {"cache", required_argument, 0, OPT_CACHE},
+                                       {"reps", required_argument, 0, OPT_REPS},
+                                       {"cost-table", required_argument, 0, OPT_COST_TABLE},
+                                       {"timing", required_argument, 0, OPT_TIMING},
                                        {"test-corrupt", required_argument, 0, OPT_TEST_CORRUPT},
                                        {0, 0, 0, 0}};
     memset(c, 0, sizeof *c);
-    c->run = (cbvh_sweep_opts){.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1};
+    c->run = (cbvh_sweep_opts){.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1, .reps = 5};
+    c->cost_dir = cbvh_cost_dir();
     c->knee_pct = 10;
     int opt;
     optind = 0;
@@ -548,6 +668,8 @@ static int validate_options(sweep_cli *c) {
         return 2;
     }
     if (!o->nmant) o->mant[o->nmant++] = CBVH_MANT_MAX;
+    if (!o->ncaches) o->cache_kb[o->ncaches++] = 64;
+    c->reps.reps = o->reps;
     if (!o->nmin_scale) o->min_scale[o->nmin_scale++] = CBVH_MIN_SCALE_DEFAULT;
     if (!c->heat_given) {
         c->heat[c->nheat++] = (heat_spec){.is_float = 1};
@@ -626,15 +748,83 @@ static int validate_run(const sweep_cli *c) {
 
 typedef struct {
     cbvh_timing_params tp;
+    cbvh_cost_table table;
     cbvh_sweep_result res;
     cbvh_fx_stats ftot; /* the float BVH's totals over effects */
     int nb, ncombo;     /* values of N; combinations M x E */
     int *bits;          /* the nb values of N */
-    double *relv;       /* [metric * nrows + row]: total cost relative to the float BVH */
+    double *relv;       /* [metric * nrows + row]: total cost relative to the float BVH (first cache) */
     double tol;         /* the knee tolerance, a fraction */
     /* knee[c][m] for the four modelled metrics (CPU time is noisy: not a knee) */
     int knee[CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];
+    /* The timing model: configuration k = 0 the float BVH, 1..nrows the
+     * settings, then the other formats; at each cache c. */
+    int ncfg, ncaches;
+    cbvh_config_model *cm;  /* [k] */
+    cbvh_ray_metrics *tot;  /* [k * ncaches + c]: totals over effects */
+    int *pareto;            /* [k * ncaches + c]: on the front of (time, energy, area) over all k and c */
+    int best[CBVH_CACHES_MAX][CBVH_FX_COUNT + 1]; /* fastest k per cache, per effect ([CBVH_FX_COUNT]: total) */
+    int best_cbvh[CBVH_CACHES_MAX];               /* fastest CBVH setting (k >= 1), total */
 } sweep_figures;
+
+static const cbvh_sweep_run_t *cfg_run(const cbvh_sweep_result *res, int k) {
+    return k == 0 ? &res->ref : k <= res->nrows ? &res->rows[k - 1] : &res->extra[k - 1 - res->nrows];
+}
+
+/* The timing model of every configuration at every cache size: machines,
+ * totals, the Pareto front and the fastest per cache and effect.  0 or -1. */
+static int model_figures(const sweep_cli *c, const cbvh_scene_desc *d, sweep_figures *f, char *err, size_t errlen) {
+    const cbvh_sweep_result *res = &f->res;
+    f->ncfg = 1 + res->nrows + res->nextra;
+    f->ncaches = c->run.ncaches;
+    size_t npt = (size_t)f->ncfg * (size_t)f->ncaches;
+    f->cm = calloc((size_t)f->ncfg, sizeof *f->cm);
+    f->tot = calloc(npt, sizeof *f->tot);
+    f->pareto = calloc(npt, sizeof *f->pareto);
+    double (*cost)[3] = calloc(npt, sizeof *cost);
+    double *v = calloc((size_t)f->ncfg, sizeof *v);
+    if (!f->cm || !f->tot || !f->pareto || !cost || !v) cbvh_out_of_memory("sweep model figures");
+    int rc = 0;
+    for (int k = 0; k < f->ncfg && !rc; k++) {
+        const cbvh_sweep_run_t *r = cfg_run(res, k);
+        rc = cbvh_config_model_init(&f->cm[k], &r->r, &f->table, &f->tp, cbvh_box_units[r->s.box_unit].cost_unit,
+                                    r->s.bits ? r->s.bits : 6, r->s.mant, err, errlen);
+        cbvh_fx_stats t = cbvh_fx_total(&r->r);
+        for (int ci = 0; ci < f->ncaches && !rc; ci++) {
+            cbvh_ray_metrics *m = &f->tot[(size_t)k * f->ncaches + ci];
+            cbvh_ray_metrics_of(&t, &f->cm[k].mc[ci], m);
+            cost[(size_t)k * f->ncaches + ci][0] = m->model_ns;
+            cost[(size_t)k * f->ncaches + ci][1] = m->energy_nj;
+            cost[(size_t)k * f->ncaches + ci][2] = m->area_lut4;
+        }
+    }
+    if (!rc) {
+        cbvh_pareto_front((const double(*)[3])cost, (int)npt, f->pareto);
+        for (int ci = 0; ci < f->ncaches; ci++) {
+            for (int e = 0; e <= CBVH_FX_COUNT; e++) {
+                f->best[ci][e] = -1;
+                if (e < CBVH_FX_COUNT && !d->effect[e].enabled) continue;
+                for (int k = 0; k < f->ncfg; k++) {
+                    const cbvh_sweep_run_t *r = cfg_run(res, k);
+                    cbvh_ray_metrics m;
+                    if (e == CBVH_FX_COUNT)
+                        m = f->tot[(size_t)k * f->ncaches + ci];
+                    else
+                        cbvh_ray_metrics_of(&r->r.fx[e], &f->cm[k].mc[ci], &m);
+                    v[k] = m.rays ? m.model_ns : NAN;
+                }
+                f->best[ci][e] = cbvh_argmin(v, f->ncfg);
+            }
+            for (int k = 0; k < f->ncfg; k++) v[k] = k >= 1 && k <= res->nrows ? f->tot[(size_t)k * f->ncaches + ci].model_ns : NAN;
+            f->best_cbvh[ci] = cbvh_argmin(v, f->ncfg);
+        }
+    }
+    free(cost);
+    free(v);
+    return rc;
+}
+
+static void free_figures(sweep_figures *f);
 
 /* 0, or 2 with one line printed: the run could not be done (not a finding
  * about hits). */
@@ -642,24 +832,42 @@ static int compute(const sweep_cli *c, const cbvh_scene_desc *d, sweep_figures *
     memset(f, 0, sizeof *f);
     cbvh_sweep_opts o = c->run;
     int tty = isatty(2);
-    if (tty) o.progress = progress;
+    if (tty) {
+        o.progress = progress;
+        o.ctx = (void *)&c->reps;
+    }
     cbvh_fx_timing(d, &f->tp);
     char err[1024];
-    if (cbvh_sweep_run(d, &o, &f->res, err, sizeof err)) {
-        if (tty) fprintf(stderr, "\n");
+    if (cbvh_timing_check(&f->tp, err, sizeof err) || (c->timing && cbvh_timing_set(&f->tp, c->timing, err, sizeof err))) {
         fprintf(stderr, "cbvh sweep: %s: %s\n", c->scene, err);
         return 2;
     }
-    if (tty) fprintf(stderr, "\r%70s\r", "");
+    o.cache_ways = (int)f->tp.cache_ways;
+    if (cbvh_cost_table_load(c->cost_dir, &f->table, err, sizeof err)) {
+        fprintf(stderr, "cbvh sweep: %s\n", err);
+        return 2;
+    }
+    if (cbvh_sweep_run(d, &o, &f->res, err, sizeof err)) {
+        if (tty) fprintf(stderr, "\n");
+        fprintf(stderr, "cbvh sweep: %s: %s\n", c->scene, err);
+        cbvh_cost_table_free(&f->table);
+        return 2;
+    }
+    if (tty) fprintf(stderr, "\r%78s\r", "");
+    if (model_figures(c, d, f, err, sizeof err)) {
+        fprintf(stderr, "cbvh sweep: %s\n", err);
+        free_figures(f);
+        return 2;
+    }
 
-    /* Relative totals per setting, for the knee and the chart. */
+    /* Relative totals per setting, for the knee and the chart (first cache). */
     const cbvh_sweep_result *res = &f->res;
     f->tol = (double)c->knee_pct / 100.0;
     f->nb = o.bits_hi - o.bits_lo + 1;
     f->ncombo = o.nmant * o.nmin_scale;
     f->ftot = cbvh_fx_total(&res->ref.r);
     double fq[SWEEP_NMETRICS];
-    cbvh_sweep_per_ray(&f->ftot, &f->tp, fq);
+    cbvh_sweep_per_ray(&f->ftot, &f->cm[0].mc[0], fq);
     f->relv = calloc((size_t)res->nrows * SWEEP_NMETRICS, sizeof *f->relv);
     f->bits = calloc((size_t)f->nb, sizeof *f->bits);
     if (!f->relv || !f->bits) cbvh_out_of_memory("sweep chart data");
@@ -667,7 +875,7 @@ static int compute(const sweep_cli *c, const cbvh_scene_desc *d, sweep_figures *
     for (int i = 0; i < res->nrows; i++) {
         cbvh_fx_stats t = cbvh_fx_total(&res->rows[i].r);
         double p[SWEEP_NMETRICS];
-        cbvh_sweep_per_ray(&t, &f->tp, p);
+        cbvh_sweep_per_ray(&t, &f->cm[1 + i].mc[0], p);
         for (int m = 0; m < SWEEP_NMETRICS; m++) f->relv[(size_t)m * res->nrows + i] = cbvh_ratio(p[m], fq[m]);
     }
     for (int k = 0; k < f->ncombo; k++)
@@ -679,24 +887,181 @@ static int compute(const sweep_cli *c, const cbvh_scene_desc *d, sweep_figures *
 static void free_figures(sweep_figures *f) {
     free(f->bits);
     free(f->relv);
+    free(f->cm);
+    free(f->tot);
+    free(f->pareto);
+    cbvh_cost_table_free(&f->table);
     cbvh_sweep_free(&f->res);
 }
 
-/* ---- write: chart, heat maps, image; then the table or the JSON ----------- */
+/* ---- write: charts, heat maps, image; then the table or the JSON ---------- */
 
 /* The files written to --out, and the first one that could not be. */
 typedef struct {
-    char written[16][2100];
+    char written[MAX_FILES][2100];
     int nwritten, nfailed;
     char failed[1100];
     double heat_max; /* the heat maps' common colour scale: 0 .. heat_max box tests */
+    double diff_max; /* the largest |extra tests| of a pixel in any difference map (each has its own scale) */
 } sweep_files;
 
 static void file_done(sweep_files *w, const char *path, int failed, const char *err) {
     if (failed) {
         if (!w->nfailed++) snprintf(w->failed, sizeof w->failed, "%s", err);
-    } else if (w->nwritten < 16)
+    } else if (w->nwritten < MAX_FILES)
         snprintf(w->written[w->nwritten++], sizeof w->written[0], "%s", path);
+}
+
+/* The table's name of configuration k (0 = the float BVH). */
+static const char *cfg_name(const sweep_cli *c, const cbvh_sweep_result *res, int k, char *name, size_t n) {
+    const cbvh_sweep_run_t *r = cfg_run(res, k);
+    if (k == 0)
+        snprintf(name, n, "float");
+    else if (k > res->nrows)
+        cbvh_sweep_format_label(&c->run.extra[k - 1 - res->nrows], r->s.mant, name, n);
+    else
+        snprintf(name, n, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
+    return name;
+}
+
+
+/* time-*.svg and energy-*.svg: the model's time and energy per ray against N,
+ * one line per M and one for the float BVH, per min scale (and box unit)
+ * and cache size. */
+static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, sweep_files *w,
+                               const double *x) {
+    const cbvh_sweep_opts *o = &c->run;
+    const char *mesh = strrchr(d->mesh_spec, '/');
+    mesh = mesh ? mesh + 1 : d->mesh_spec;
+    int nm = o->nmant < 11 ? o->nmant : 11; /* 12 series at most: the Ms and the float BVH */
+    double *y = calloc((size_t)(nm + 1) * f->nb, sizeof *y);
+    char (*names)[32] = calloc((size_t)nm + 1, sizeof *names);
+    if (!y || !names) cbvh_out_of_memory("sweep model charts");
+    for (int e = 0; e < o->nmin_scale; e++)
+        for (int ci = 0; ci < f->ncaches; ci++)
+            for (int q = 0; q < 2; q++) { /* 0: time, 1: energy */
+                cbvh_svg_series ser[12];
+                for (int mi = 0; mi < nm; mi++) {
+                    snprintf(names[mi], sizeof names[mi], "CBVH M=%d", o->mant[mi]);
+                    for (int b = 0; b < f->nb; b++) {
+                        int row = (mi * o->nmin_scale + e) * f->nb + b; /* rows: each M, each E, N ascending */
+                        const cbvh_ray_metrics *m = &f->tot[(size_t)(1 + row) * f->ncaches + ci];
+                        y[(size_t)mi * f->nb + b] = q ? m->energy_nj : m->model_ns;
+                    }
+                    ser[mi] = (cbvh_svg_series){names[mi], &y[(size_t)mi * f->nb]};
+                }
+                snprintf(names[nm], sizeof names[nm], "float BVH");
+                for (int b = 0; b < f->nb; b++)
+                    y[(size_t)nm * f->nb + b] = q ? f->tot[ci].energy_nj : f->tot[ci].model_ns;
+                ser[nm] = (cbvh_svg_series){names[nm], &y[(size_t)nm * f->nb]};
+                int ok = 1;
+                for (size_t i = 0; i < (size_t)(nm + 1) * f->nb; i++) ok &= isfinite(y[i]) != 0;
+                if (!ok) continue;
+                char tag[32], cn[32], path[2048], title[1400], err[1024];
+                cbvh_cache_name_unit(o->cache_kb[ci], "", tag, sizeof tag);
+                if (o->nmin_scale == 1)
+                    snprintf(path, sizeof path, "%s/%s-C%s.svg", c->outdir, q ? "energy" : "time", tag);
+                else
+                    snprintf(path, sizeof path, "%s/%s-E%d-C%s.svg", c->outdir, q ? "energy" : "time",
+                             o->min_scale[e], tag);
+                snprintf(title, sizeof title, "%s: modelled %s per ray, cache %s, min scale %d, %s box unit", mesh,
+                         q ? "energy" : "time", cbvh_cache_name(o->cache_kb[ci], cn, sizeof cn), o->min_scale[e],
+                         cbvh_box_units[0].name);
+                int bad = cbvh_svg_chart(path, title, "coordinate bits N", q ? "nJ per ray" : "ns per ray", x,
+                                         (size_t)f->nb, ser, (size_t)nm + 1, err, sizeof err);
+                file_done(w, path, bad, err);
+            }
+    free(y);
+    free(names);
+}
+
+/* The setting of heat map h: its configuration. */
+static const cbvh_sweep_run_t *heat_run(const sweep_cli *c, const cbvh_sweep_result *res, const heat_spec *hs) {
+    if (hs->xf) return &res->extra[hs->xf - 1];
+    if (!hs->is_float)
+        for (int i = 0; i < res->nrows; i++)
+            if (res->rows[i].s.bits == hs->bits && res->rows[i].s.mant == hs->mant &&
+                res->rows[i].s.min_scale == hs->min_scale)
+                return &res->rows[i];
+    (void)c;
+    return &res->ref;
+}
+
+static void heat_label(const sweep_cli *c, const heat_spec *hs, char *out, size_t n) {
+    if (hs->is_float)
+        snprintf(out, n, "float BVH");
+    else if (hs->xf)
+        snprintf(out, n, "%s", c->run.extra[hs->xf - 1].name);
+    else
+        snprintf(out, n, "CBVH N=%d M=%d E=%d", hs->bits, hs->mant, hs->min_scale);
+}
+
+static void heat_path(const sweep_cli *c, const heat_spec *hs, const char *prefix, char *path, size_t n) {
+    if (hs->is_float)
+        snprintf(path, n, "%s/%s-float.png", c->outdir, prefix);
+    else if (hs->xf) {
+        char fn[48];
+        snprintf(fn, sizeof fn, "%s", c->run.extra[hs->xf - 1].name);
+        for (char *p = fn; *p; p++)
+            if (*p == ':') *p = '-';
+        snprintf(path, n, "%s/%s-%s.png", c->outdir, prefix, fn);
+    } else if (hs->explicit_all)
+        snprintf(path, n, "%s/%s-N%d-M%d-E%d.png", c->outdir, prefix, hs->bits, hs->mant, hs->min_scale);
+    else
+        snprintf(path, n, "%s/%s-N%d.png", c->outdir, prefix, hs->bits);
+}
+
+/* heat-*.png: box tests per pixel on one colour scale; diff-*.png: extra box
+ * and triangle tests per pixel against the float BVH, on one symmetric scale. */
+static void write_heat_maps(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, sweep_files *w) {
+    const cbvh_sweep_result *res = &f->res;
+    const cbvh_sweep_run_t *hr[MAX_HEAT];
+    size_t npx = (size_t)res->width * (size_t)res->height;
+    double vmax = 0, dmax = 0;
+    double *diff = calloc(npx, sizeof *diff);
+    if (!diff) cbvh_out_of_memory("difference heat map");
+    for (int h = 0; h < c->nheat; h++) {
+        hr[h] = heat_run(c, res, &c->heat[h]);
+        for (size_t p = 0; p < npx; p++) {
+            if (hr[h]->box_px[p] > vmax) vmax = hr[h]->box_px[p];
+            double x = fabs(hr[h]->box_px[p] + hr[h]->tri_px[p] - res->ref.box_px[p] - res->ref.tri_px[p]);
+            if (!c->heat[h].is_float && x > dmax) dmax = x;
+        }
+    }
+    if (!(vmax > 0)) vmax = 1;
+    if (!(dmax > 0)) dmax = 1;
+    w->heat_max = vmax;
+    w->diff_max = dmax;
+    const char *mesh = strrchr(d->mesh_spec, '/');
+    mesh = mesh ? mesh + 1 : d->mesh_spec;
+    char path[2048], title[1300], what[96], err[1024];
+    for (int h = 0; h < c->nheat; h++) {
+        const heat_spec *hs = &c->heat[h];
+        heat_label(c, hs, what, sizeof what);
+        heat_path(c, hs, "heat", path, sizeof path);
+        snprintf(title, sizeof title, "%s: box tests per pixel, %s", mesh, what);
+        cbvh_heatmap_style st = {title, "box tests per primary-ray pixel (frame 0, mean over samples)", 0, vmax, 0,
+                                 512};
+        file_done(w, path,
+                  cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res->width, (unsigned)res->height, &st, NULL, err,
+                                   sizeof err),
+                  err);
+        if (hs->is_float) continue;
+        double dm = 0;
+        for (size_t p = 0; p < npx; p++) {
+            diff[p] = hr[h]->box_px[p] + hr[h]->tri_px[p] - res->ref.box_px[p] - res->ref.tri_px[p];
+            if (fabs(diff[p]) > dm) dm = fabs(diff[p]);
+        }
+        heat_path(c, hs, "diff", path, sizeof path);
+        snprintf(title, sizeof title, "%s: extra tests per pixel, %s - float BVH", mesh, what);
+        cbvh_heatmap_style ds = {title, "box + triangle tests per pixel, minus the float BVH's (red: more)",
+                                 -(dm > 0 ? dm : 1), dm > 0 ? dm : 1, 1, 512};
+        file_done(w, path,
+                  cbvh_heatmap_png(path, diff, (unsigned)res->width, (unsigned)res->height, &ds, NULL, err,
+                                   sizeof err),
+                  err);
+    }
+    free(diff);
 }
 
 static void write_files(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, sweep_files *w) {
@@ -727,64 +1092,75 @@ static void write_files(const sweep_cli *c, const cbvh_scene_desc *d, const swee
                                  (size_t)nser, err, sizeof err);
         file_done(w, path, bad, err);
     }
+    write_model_charts(c, d, f, w, x);
     free(x);
-    /* Heat maps on one colour scale: 0 .. the largest pixel of any chosen setting. */
-    const cbvh_sweep_run_t *hr[MAX_HEAT];
-    double vmax = 0;
-    size_t npx = (size_t)res->width * (size_t)res->height;
-    for (int h = 0; h < c->nheat; h++) {
-        const heat_spec *hs = &c->heat[h];
-        hr[h] = hs->xf ? &res->extra[hs->xf - 1] : &res->ref;
-        if (!hs->is_float && !hs->xf)
-            for (int i = 0; i < res->nrows; i++)
-                if (res->rows[i].s.bits == hs->bits && res->rows[i].s.mant == hs->mant &&
-                    res->rows[i].s.min_scale == hs->min_scale)
-                    hr[h] = &res->rows[i];
-        for (size_t p = 0; p < npx; p++)
-            if (hr[h]->box_px[p] > vmax) vmax = hr[h]->box_px[p];
-    }
-    if (!(vmax > 0)) vmax = 1;
-    double used_min = 0;
-    w->heat_max = vmax;
-    for (int h = 0; h < c->nheat; h++) {
-        const heat_spec *hs = &c->heat[h];
-        if (hs->is_float)
-            snprintf(path, sizeof path, "%s/heat-float.png", outdir);
-        else if (hs->xf) {
-            char fn[48];
-            snprintf(fn, sizeof fn, "%s", c->run.extra[hs->xf - 1].name);
-            for (char *p = fn; *p; p++)
-                if (*p == ':') *p = '-';
-            snprintf(path, sizeof path, "%s/heat-%s.png", outdir, fn);
-        } else if (hs->explicit_all)
-            snprintf(path, sizeof path, "%s/heat-N%d-M%d-E%d.png", outdir, hs->bits, hs->mant, hs->min_scale);
-        else
-            snprintf(path, sizeof path, "%s/heat-N%d.png", outdir, hs->bits);
-        int bad = cbvh_heatmap_png(path, hr[h]->box_px, (unsigned)res->width, (unsigned)res->height, 0, vmax, 0,
-                                   &used_min, &w->heat_max, err, sizeof err);
-        file_done(w, path, bad, err);
-    }
+    write_heat_maps(c, d, f, w);
     snprintf(path, sizeof path, "%s/render-float.png", outdir);
     int bad = cbvh_png_write(path, res->ref.image, (unsigned)res->width, (unsigned)res->height, 1, err, sizeof err);
     file_done(w, path, bad, err);
 }
 
-/* The "effects" and "total" of one traced configuration against the float BVH's. */
-static void json_effects(cJSON *o, const cbvh_scene_desc *d, const sweep_figures *f, const cbvh_sweep_run_t *r) {
-    const cbvh_sweep_run_t *ref = &f->res.ref;
+/* The "effects" and "total" of configuration k against the float BVH's. */
+static void json_effects(cJSON *o, const cbvh_scene_desc *d, const sweep_figures *f, int k) {
+    const cbvh_sweep_run_t *ref = &f->res.ref, *r = cfg_run(&f->res, k);
     cJSON *ef = cJSON_AddObjectToObject(o, "effects");
     for (int e = 0; e < CBVH_FX_COUNT; e++)
         if (d->effect[e].enabled)
             cJSON_AddItemToObject(ef, cbvh_effect_name((cbvh_effect)e),
-                                  json_costs(&r->r.fx[e], &ref->r.fx[e], r->r.node_bytes, ref->r.node_bytes, &f->tp));
+                                  json_costs(&r->r.fx[e], &ref->r.fx[e], r->r.node_bytes, ref->r.node_bytes, &f->cm[k],
+                                             &f->cm[0]));
     cbvh_fx_stats t = cbvh_fx_total(&r->r);
-    cJSON_AddItemToObject(o, "total", json_costs(&t, &f->ftot, r->r.node_bytes, ref->r.node_bytes, &f->tp));
+    cJSON_AddItemToObject(o, "total", json_costs(&t, &f->ftot, r->r.node_bytes, ref->r.node_bytes, &f->cm[k], &f->cm[0]));
+    cJSON_AddStringToObject(o, "box_unit", cbvh_box_units[r->s.box_unit].name);
+    cJSON_AddNumberToObject(o, "area_lut4", f->tot[(size_t)k * f->ncaches].area_lut4);
+    cJSON *pa = cJSON_AddArrayToObject(o, "pareto");
+    for (int ci = 0; ci < f->ncaches; ci++) cJSON_AddItemToArray(pa, cJSON_CreateBool(f->pareto[(size_t)k * f->ncaches + ci]));
+}
+
+static void json_machine(cJSON *root, const sweep_cli *c, const sweep_figures *f) {
+    cJSON *tj = cJSON_AddObjectToObject(root, "timing");
+    cbvh_timing_json(tj, &f->tp, c->cost_dir);
+    cJSON *ca = cJSON_AddArrayToObject(tj, "caches_kb");
+    for (int ci = 0; ci < f->ncaches; ci++)
+        cJSON_AddItemToArray(ca, isfinite(c->run.cache_kb[ci]) ? cJSON_CreateNumber(c->run.cache_kb[ci]) : cJSON_CreateNull());
+    cJSON_AddNumberToObject(tj, "cpu_reps", c->run.reps);
+    cJSON *un = cJSON_AddObjectToObject(tj, "units");
+    const cbvh_timing_units *fu = &f->cm[0].mc[0].units;
+    cJSON_AddItemToObject(un, "box", cbvh_unit_json(&fu->node));
+    cJSON_AddItemToObject(un, "triangle", cbvh_unit_json(&fu->tri));
+    if (f->res.nrows) {
+        cJSON *dec = cJSON_AddArrayToObject(un, "decoder");
+        for (int b = 0; b < f->nb; b++) cJSON_AddItemToArray(dec, cbvh_unit_json(&f->cm[1 + b].mc[0].units.dec));
+    }
+}
+
+static void json_best(cJSON *root, const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f) {
+    cJSON *bj = cJSON_AddArrayToObject(root, "best");
+    char name[64];
+    for (int ci = 0; ci < f->ncaches; ci++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(bj, o);
+        json_rel(o, "cache_kb", c->run.cache_kb[ci]);
+        for (int e = 0; e <= CBVH_FX_COUNT; e++) {
+            int k = f->best[ci][e];
+            if (k < 0) continue;
+            cJSON_AddStringToObject(o, e == CBVH_FX_COUNT ? "total" : cbvh_effect_name((cbvh_effect)e),
+                                    cfg_name(c, &f->res, k, name, sizeof name));
+        }
+        int kb = f->best_cbvh[ci];
+        if (kb > 0) {
+            const cbvh_ray_metrics *b = &f->tot[(size_t)kb * f->ncaches + ci], *fl = &f->tot[ci];
+            cJSON_AddStringToObject(o, "best_cbvh", cfg_name(c, &f->res, kb, name, sizeof name));
+            json_rel(o, "best_cbvh_time_vs_float", cbvh_ratio(b->model_ns, fl->model_ns));
+            json_rel(o, "best_cbvh_energy_vs_float", cbvh_ratio(b->energy_nj, fl->energy_nj));
+        }
+    }
+    (void)d;
 }
 
 static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, const sweep_files *w) {
     static const char *knee_keys[4] = {"box_tests", "tri_tests", "bytes", "model_time"};
     const cbvh_sweep_result *res = &f->res;
-    const cbvh_timing_params *tp = &f->tp;
     cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "scene", c->scene);
     cJSON_AddStringToObject(root, "mesh", d->mesh_spec);
@@ -794,20 +1170,10 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
     cJSON_AddNumberToObject(root, "spp", res->spp);
     cJSON_AddNumberToObject(root, "frames", res->frames);
     cJSON_AddNumberToObject(root, "rays", (double)res->ref_rays);
-    cJSON *tj = cJSON_AddObjectToObject(root, "timing");
-    cJSON_AddNumberToObject(tj, "box_cycles", tp->box_cycles);
-    cJSON_AddNumberToObject(tj, "tri_cycles", tp->tri_cycles);
-    cJSON_AddNumberToObject(tj, "fetch_latency", tp->fetch_latency);
-    cJSON_AddNumberToObject(tj, "dram_bytes_per_cycle", tp->dram_bytes_per_cycle);
-    cJSON_AddNumberToObject(tj, "clock_mhz", tp->clock_mhz);
+    json_machine(root, c, f);
     cJSON *fl = cJSON_AddObjectToObject(root, "float");
     cJSON_AddNumberToObject(fl, "node_bytes", (double)res->ref.r.node_bytes);
-    cJSON *fe = cJSON_AddObjectToObject(fl, "effects");
-    for (int e = 0; e < CBVH_FX_COUNT; e++)
-        if (d->effect[e].enabled)
-            cJSON_AddItemToObject(fe, cbvh_effect_name((cbvh_effect)e),
-                                  json_costs(&res->ref.r.fx[e], &res->ref.r.fx[e], 1, 1, tp));
-    cJSON_AddItemToObject(fl, "total", json_costs(&f->ftot, &f->ftot, 1, 1, tp));
+    json_effects(fl, d, f, 0);
     cJSON *rows = cJSON_AddArrayToObject(root, "settings");
     for (int i = 0; i < res->nrows; i++) {
         const cbvh_sweep_run_t *r = &res->rows[i];
@@ -818,7 +1184,7 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         cJSON_AddNumberToObject(row, "node_bytes", (double)r->r.node_bytes);
         cJSON_AddBoolToObject(row, "same_hits", r->same);
         if (!r->same) cJSON_AddStringToObject(row, "first_difference", r->why);
-        json_effects(row, d, f, r);
+        json_effects(row, d, f, 1 + i);
         cJSON_AddItemToArray(rows, row);
     }
     cJSON *fj = res->nextra ? cJSON_AddArrayToObject(root, "formats") : NULL;
@@ -833,7 +1199,7 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         cJSON_AddNumberToObject(qj, "ray_sphere", (double)r->r.units.ray_sphere);
         cJSON_AddBoolToObject(qj, "same_hits", r->same);
         if (!r->same) cJSON_AddStringToObject(qj, "first_difference", r->why);
-        json_effects(qj, d, f, r);
+        json_effects(qj, d, f, 1 + res->nrows + k);
     }
     cJSON *kn = cJSON_AddArrayToObject(root, "knee");
     for (int k = 0; k < f->ncombo; k++) {
@@ -849,52 +1215,109 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
                 cJSON_AddNullToObject(o, knee_keys[m]); /* no ratio: the float BVH did none */
         cJSON_AddItemToArray(kn, o);
     }
+    json_best(root, c, d, f);
     cJSON_AddBoolToObject(root, "same_hits", res->all_same);
     cJSON_AddNumberToObject(root, "heatmap_max_box_tests", w->heat_max);
+    cJSON_AddNumberToObject(root, "diffmap_max_extra_tests", w->diff_max);
     cJSON *wr = cJSON_AddArrayToObject(root, "files");
     for (int k = 0; k < w->nwritten; k++) cJSON_AddItemToArray(wr, cJSON_CreateString(w->written[k]));
     cbvh_json_print(root, stdout);
     cJSON_Delete(root);
 }
 
-/* The table's name of row i (-1 = the float BVH, nrows.. = the other formats). */
-static const cbvh_sweep_run_t *row_named(const sweep_cli *c, const cbvh_sweep_result *res, int i, char *name,
-                                         size_t n) {
-    const cbvh_sweep_run_t *r = i < 0 ? &res->ref : i >= res->nrows ? &res->extra[i - res->nrows] : &res->rows[i];
-    if (i < 0)
-        snprintf(name, n, "float");
-    else if (i >= res->nrows)
-        cbvh_sweep_format_label(&c->run.extra[i - res->nrows], r->s.mant, name, n);
-    else
-        snprintf(name, n, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
-    return r;
+/* "What accuracy costs in time": every configuration at every cache size. */
+static void write_model_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f) {
+    const cbvh_sweep_result *res = &f->res;
+    char line[400], name[64], cn[32];
+    cbvh_machine_line(&f->tp, line, sizeof line);
+    printf("\nWhat accuracy costs in time (timing model, docs/timing_model.md): %s\n", line);
+    printf("%-28s %-6s %7s %9s %8s %10s %9s %6s %6s %6s %-13s %-20s | %7s %7s %7s  %s\n", "setting", "box", "cache",
+           "ns/ray", "nJ/ray", "area LUT4", "DRAM B/r", "hit %", "fp box", "fp tri", "bound", "CPU us/ray [min-max]",
+           "time", "energy", "area", "P");
+    printf("%-28s %-6s %7s %9s %8s %10s %9s %6s %6s %6s %-13s %-20s | %25s\n", "", "unit", "", "", "", "", "", "", "",
+           "", "", "", "x the float BVH (same cache)");
+    for (int k = 0; k < f->ncfg; k++) {
+        const cbvh_sweep_run_t *r = cfg_run(res, k);
+        cfg_name(c, res, k, name, sizeof name);
+        cbvh_fx_stats t = cbvh_fx_total(&r->r);
+        int sphere = t.ops.ray_sphere > 0;
+        for (int ci = 0; ci < f->ncaches; ci++) {
+            const cbvh_ray_metrics *m = &f->tot[(size_t)k * f->ncaches + ci], *fl = &f->tot[ci];
+            char cpu[40];
+            snprintf(cpu, sizeof cpu, "%.2f [%.2f-%.2f]", m->cpu_us, m->cpu_lo, m->cpu_hi);
+            printf("%-28s %-6s %7s %9.1f %8.3f %10.0f %9.1f %6.1f %6s %6s %-13s %-20s |", name,
+                   sphere ? "sphere" : cbvh_box_units[r->s.box_unit].name,
+                   cbvh_cache_name(c->run.cache_kb[ci], cn, sizeof cn), m->model_ns, m->energy_nj, m->area_lut4,
+                   m->dram_bytes, 100.0 * m->hit_rate, sphere ? "-" : "0", sphere ? "-" : "0",
+                   cbvh_timing_bound_name(m->bound), cpu);
+            print_rel(cbvh_ratio(m->model_ns, fl->model_ns));
+            print_rel(cbvh_ratio(m->energy_nj, fl->energy_nj));
+            print_rel(cbvh_ratio(m->area_lut4, fl->area_lut4));
+            printf("  %s\n", f->pareto[(size_t)k * f->ncaches + ci] ? "*" : "");
+        }
+    }
+    printf("P * = on the Pareto front of (time, energy, area) over every row and cache size. fp box / fp tri: false-"
+           "positive box hits and the extra triangle tests they cause, per ray: none for the exact unit (issue 35's "
+           "incremental unit adds them).\n");
+    printf("fastest in modelled time (CPU time is the C model's own, not the accelerator's):\n");
+    for (int ci = 0; ci < f->ncaches; ci++) {
+        cbvh_cache_name(c->run.cache_kb[ci], cn, sizeof cn);
+        for (int e = CBVH_FX_COUNT; e >= 0; e--) {
+            int k = f->best[ci][e];
+            if (k < 0) continue;
+            const cbvh_sweep_run_t *r = cfg_run(res, k);
+            cbvh_ray_metrics m, fm;
+            if (e == CBVH_FX_COUNT) {
+                m = f->tot[(size_t)k * f->ncaches + ci];
+                fm = f->tot[ci];
+            } else {
+                cbvh_ray_metrics_of(&r->r.fx[e], &f->cm[k].mc[ci], &m);
+                cbvh_ray_metrics_of(&res->ref.r.fx[e], &f->cm[0].mc[ci], &fm);
+            }
+            printf("  cache %-7s %-17s %-28s %9.1f ns/ray x%.3f, %8.3f nJ/ray x%.3f the float BVH's\n", cn,
+                   e == CBVH_FX_COUNT ? "all effects:" : cbvh_effect_name((cbvh_effect)e),
+                   cfg_name(c, res, k, name, sizeof name), m.model_ns, cbvh_ratio(m.model_ns, fm.model_ns),
+                   m.energy_nj, cbvh_ratio(m.energy_nj, fm.energy_nj));
+        }
+        int kb = f->best_cbvh[ci];
+        if (kb > 0) {
+            const cbvh_ray_metrics *b = &f->tot[(size_t)kb * f->ncaches + ci], *fl = &f->tot[ci];
+            printf("  cache %-7s best CBVH %s: time x%.3f, energy x%.3f, area x%.3f against the float BVH: CBVH %s\n",
+                   cn, cfg_name(c, res, kb, name, sizeof name), cbvh_ratio(b->model_ns, fl->model_ns),
+                   cbvh_ratio(b->energy_nj, fl->energy_nj), cbvh_ratio(b->area_lut4, fl->area_lut4),
+                   b->model_ns < fl->model_ns ? "beats float in modelled time" : "does not beat float in modelled time");
+        }
+    }
+    (void)d;
 }
 
 static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, const sweep_files *w) {
     const cbvh_sweep_result *res = &f->res;
-    const cbvh_timing_params *tp = &f->tp;
     int nb = f->nb;
+    char cn[32];
     printf("scene %s: %s, %u triangles, %dx%d, %d spp, %d frame%s; %llu rays per setting\n", c->scene, d->mesh_spec,
            d->mesh.ntris, res->width, res->height, res->spp, res->frames, res->frames > 1 ? "s" : "",
            (unsigned long long)res->ref_rays);
-    printf("timing model: %g cycle/box, %g cycle/tri, %g cycles fetch latency, %g B/cycle DRAM, %g MHz "
-           "(docs/timing_model.md)\n\n",
-           tp->box_cycles, tp->tri_cycles, tp->fetch_latency, tp->dram_bytes_per_cycle, tp->clock_mhz);
+    printf("model ns: the timing model at cache %s (docs/timing_model.md; every cache size below); CPU us: the "
+           "median of %d timed repetitions\n\n",
+           cbvh_cache_name(c->run.cache_kb[0], cn, sizeof cn), c->run.reps);
     printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %7s %7s %7s %7s %7s %7s  %s\n", "setting", "effect", "rays",
            "box/ray", "tri/ray", "B/ray", "model ns", "CPU us", "box", "tri", "bytes", "memory", "model", "CPU",
            "hits");
     printf("%-28s %-17s %8s %8s %7s %8s %9s %7s | %55s\n", "", "", "", "", "", "", "", "",
            "relative to the float BVH ----------------------------");
-    char name[48];
-    for (int i = -1; i < res->nrows + res->nextra; i++) {
-        const cbvh_sweep_run_t *r = row_named(c, res, i, name, sizeof name);
-        const char *same = i < 0 ? "reference" : r->same ? "same" : "DIFFERENT";
+    char name[64];
+    for (int k = 0; k < f->ncfg; k++) {
+        const cbvh_sweep_run_t *r = cfg_run(res, k);
+        cfg_name(c, res, k, name, sizeof name);
+        const char *same = k == 0 ? "reference" : r->same ? "same" : "DIFFERENT";
         for (int e = 0; e < CBVH_FX_COUNT; e++)
             if (d->effect[e].enabled)
                 text_row(name, cbvh_effect_name((cbvh_effect)e), &r->r.fx[e], &res->ref.r.fx[e], r->r.node_bytes,
-                         res->ref.r.node_bytes, tp, same);
+                         res->ref.r.node_bytes, &f->cm[k].mc[0], &f->cm[0].mc[0], same);
         cbvh_fx_stats t = cbvh_fx_total(&r->r);
-        text_row(name, "total", &t, &f->ftot, r->r.node_bytes, res->ref.r.node_bytes, tp, same);
+        text_row(name, "total", &t, &f->ftot, r->r.node_bytes, res->ref.r.node_bytes, &f->cm[k].mc[0],
+                 &f->cm[0].mc[0], same);
     }
     printf("\nnode memory: float BVH %llu B", (unsigned long long)res->ref.r.node_bytes);
     for (int b = 0; b < nb; b++)
@@ -928,6 +1351,7 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
                 print_x(f->relv[(size_t)SWEEP_TRI * res->nrows + k * nb + b]);
                 printf("\n");
             }
+    write_model_text(c, d, f);
     char others[CBVH_FORMAT_NAME_MAX + 16];
     if (res->all_same)
         printf("hits: all %d settings%s%s return the float BVH's hits on all %llu rays (same triangle and t bits; no "
@@ -943,7 +1367,10 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
             if (!res->extra[k].same)
                 printf("hits: %s DIFFERENT from the float BVH: %s\n", c->run.extra[k].name, res->extra[k].why);
     }
-    printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all\n", w->heat_max);
+    printf("heat maps: box tests per primary-ray pixel, colour scale 0..%.1f for all; difference maps: extra box + "
+           "triangle tests per pixel against the float BVH, each on its own scale symmetric around 0 (largest |extra| "
+           "%.1f)\n",
+           w->heat_max, w->diff_max);
     for (int k = 0; k < w->nwritten; k++) printf("wrote %s\n", w->written[k]);
 }
 

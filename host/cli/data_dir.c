@@ -1,6 +1,7 @@
 #include "cli/data_dir.h"
 
 #include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -24,5 +25,11 @@ const char *cbvh_data_dir(void) {
     memcpy(slash + 1, CBVH_DATA_FROM_BINDIR, rel + 1);
     struct stat st;
     if (realpath(exe, resolved) && stat(resolved, &st) == 0 && S_ISDIR(st.st_mode)) dir = resolved;
+    return dir;
+}
+
+const char *cbvh_cost_dir(void) {
+    static char dir[PATH_MAX + 16];
+    if (!dir[0]) snprintf(dir, sizeof dir, "%s/gateware/cost", cbvh_data_dir());
     return dir;
 }

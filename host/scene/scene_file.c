@@ -374,15 +374,21 @@ static int parse_animation(pctx *c, const cJSON *a, cbvh_scene_desc *d) {
 
 static int parse_timing(pctx *c, const cJSON *t, cbvh_scene_desc *d) {
     if (!cJSON_IsObject(t)) return fail(c, "timing", "expected an object");
-    static const char *const keys[] = {"box_cycles", "tri_cycles", "fetch_latency", "dram_bytes_per_cycle",
-                                       "clock_mhz", NULL};
+    static const char *const keys[] = {"box_cycles",      "tri_cycles",        "fetch_latency",
+                                       "dram_bytes_per_cycle", "clock_mhz",   "rays_in_flight",
+                                       "cache_hit_latency", "cache_ways",     "unit_cycle_scale",
+                                       "dram_pj_per_byte", "sram_pj_per_word", "issue_width", NULL};
+    /* rates (bandwidth, clock, rays in flight, cycle scale) bounded away from 0 */
+    static const double lo[] = {0, 0, 0, CBVH_TIMING_RATE_MIN, CBVH_TIMING_RATE_MIN, CBVH_TIMING_RATE_MIN, 0, 1,
+                                CBVH_TIMING_RATE_MIN, 0, 0, 1};
     if (check_keys(c, t, "timing", keys)) return -1;
-    double *dst[] = {&d->timing.box_cycles, &d->timing.tri_cycles, &d->timing.fetch_latency,
-                     &d->timing.dram_bytes_per_cycle, &d->timing.clock_mhz};
-    for (int i = 0; keys[i]; i++) {
-        double lo = i >= 3 ? CBVH_TIMING_RATE_MIN : 0; /* bandwidth and clock: a rate, bounded away from 0 */
-        if (get_num(c, t, "timing", keys[i], lo, 0, CBVH_TIMING_MAX, dst[i], 0) < 0) return -1;
-    }
+    cbvh_timing_overrides *o = &d->timing;
+    double *dst[] = {&o->box_cycles,     &o->tri_cycles,        &o->fetch_latency,    &o->dram_bytes_per_cycle,
+                     &o->clock_mhz,      &o->rays_in_flight,    &o->cache_hit_latency, &o->cache_ways,
+                     &o->unit_cycle_scale, &o->dram_pj_per_byte, &o->sram_pj_per_word, &o->issue_width};
+    for (int i = 0; keys[i]; i++)
+        if (get_num(c, t, "timing", keys[i], lo[i], 0, i == 7 ? 64 : i == 11 ? 1024 : CBVH_TIMING_MAX, dst[i], 0) < 0)
+            return -1;
     return 0;
 }
 
@@ -445,7 +451,9 @@ int cbvh_scene_file_parse(const char *text, const char *path, cbvh_scene_desc *d
     }
     int rc = -1;
     d->timing.box_cycles = d->timing.tri_cycles = d->timing.fetch_latency = d->timing.dram_bytes_per_cycle =
-        d->timing.clock_mhz = NAN;
+        d->timing.clock_mhz = d->timing.rays_in_flight = d->timing.cache_hit_latency = d->timing.cache_ways =
+            d->timing.unit_cycle_scale = d->timing.dram_pj_per_byte = d->timing.sram_pj_per_word =
+                d->timing.issue_width = NAN;
     d->seed = 1;
     static const char *const keys[] = {"mesh", "camera", "lights", "materials", "mesh_material", "floor",
                                        "effects", "animation", "timing", "seed", NULL};

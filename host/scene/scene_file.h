@@ -72,6 +72,8 @@ typedef struct {
 /* Timing-model overrides (docs/timing_model.md); NaN = default. */
 typedef struct {
     double box_cycles, tri_cycles, fetch_latency, dram_bytes_per_cycle, clock_mhz;
+    double rays_in_flight, cache_hit_latency, cache_ways, unit_cycle_scale, dram_pj_per_byte, sram_pj_per_word;
+    double issue_width;
 } cbvh_timing_overrides;
 
 #define CBVH_MAX_LIGHTS 16

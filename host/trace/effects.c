@@ -83,6 +83,7 @@ typedef struct {
     int frame;
     int px, py;     /* pixel being traced (for observers) */
     uint8_t *had_ray; /* fisheye: per pixel, 1 once a sample made a camera ray (any frame) */
+    cbvh_memsim *mem; /* the timing model's caches, or NULL */
 } tracer;
 
 static double cpu_now(void) {
@@ -127,9 +128,11 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
     /* One-sided scenes: the same rule on every format (the reference included). */
     cbvh_trav_mode tm = T->o->one_sided ? (cbvh_trav_mode)(mode | CBVH_TRAV_FRONT_ONLY) : mode;
     cbvh_format_from from = {src, T->px, T->py};
+    if (T->mem) cbvh_memsim_ray_begin(T->mem, T->res->fx[fx].mem);
     double clk = ray_clock_overhead(), t0 = ray_clock();
     int rc = T->F->trace(T->state, T->tris, &r, tm, &from, hit, &st);
     double dt = ray_clock() - t0 - clk;
+    if (T->mem) cbvh_memsim_ray_end(T->mem, &st);
     if (rc) memset(hit, 0, sizeof *hit);
     cbvh_fx_stats_add_ray(&T->res->fx[fx], mode, rc, hit->hit, &st, dt > 0 ? dt : 0);
     /* Closest hit: triangle and t are defined (same on every format); any hit: only whether. */
@@ -298,6 +301,8 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     if (cbvh_format_parse(o->format ? o->format : "float", &T.F, spec, sizeof spec, err, errlen)) return -1;
     r->frames = cbvh_scene_desc_frames(d);
     r->ntris = d->mesh.ntris;
+    r->format_flags = T.F->flags;
+    snprintf(r->format, sizeof r->format, "%s", spec);
     T.tris = malloc((size_t)d->mesh.ntris * sizeof *T.tris);
     if (!T.tris) cbvh_out_of_memory("frame triangles");
     cbvh_scene_desc_frame(d, 0, T.tris);
@@ -319,8 +324,20 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
                             .pinhole = c->type == CBVH_CAM_PINHOLE ? &pin : NULL};
     for (int a = 0; a < 3; a++) in.origin_max = fmaxf(in.origin_max, fabsf(c->position[a]) + fabsf(c->aperture));
     int rc = -1;
+    cbvh_memsim mem;
+    if (o->ncaches > 0) {
+        if (cbvh_memsim_init(&mem, o->cache_kb, o->ncaches, o->cache_ways > 0 ? (uint32_t)o->cache_ways : 8u, o->steps,
+                             err, errlen)) {
+            free(T.tris);
+            return -1;
+        }
+        T.mem = &mem;
+        r->ncaches = o->ncaches;
+        memcpy(r->cache_kb, o->cache_kb, (size_t)o->ncaches * sizeof *o->cache_kb);
+    }
     double b0 = cpu_now();
     if (T.F->build(&in, &T.state, &r->units, err, errlen)) {
+        if (T.mem) cbvh_memsim_free(T.mem);
         free(T.tris);
         return -1;
     }
@@ -331,6 +348,7 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
         T.had_ray = calloc(npx, 1);
         if (!T.had_ray) cbvh_out_of_memory("fisheye pixel map");
     }
+    if (T.mem) cbvh_trav_set_observer(&T.mem->obs);
     for (T.frame = 0; T.frame < r->frames; T.frame++) {
         if (T.frame > 0) {
             /* Animation: move the vertices and refit (never for a static scene). */
@@ -345,8 +363,13 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     for (size_t p = 0; T.had_ray && p < npx; p++) r->pixels_without_ray += !T.had_ray[p];
     cbvh_fx_stats total = cbvh_fx_total(r);
     T.F->units(&total.st, &r->units); /* the units the traversals ran */
+    for (int e = 0; e < CBVH_FX_COUNT; e++) T.F->units(&r->fx[e].st, &r->fx[e].ops);
     rc = 0;
 out:
+    if (T.mem) {
+        cbvh_trav_set_observer(NULL);
+        cbvh_memsim_free(T.mem);
+    }
     free(T.had_ray);
     T.F->free(T.state);
     free(T.tris);
@@ -362,10 +385,34 @@ cbvh_fx_stats cbvh_fx_total(const cbvh_fx_result *r) {
 void cbvh_fx_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp) {
     cbvh_timing_defaults(tp);
     const cbvh_timing_overrides *o = &d->timing;
-    if (!isnan(o->box_cycles)) tp->box_cycles = o->box_cycles;
-    if (!isnan(o->tri_cycles)) tp->tri_cycles = o->tri_cycles;
-    if (!isnan(o->fetch_latency)) tp->fetch_latency = o->fetch_latency;
-    if (!isnan(o->dram_bytes_per_cycle)) tp->dram_bytes_per_cycle = o->dram_bytes_per_cycle;
-    if (!isnan(o->clock_mhz)) tp->clock_mhz = o->clock_mhz;
+    const double *src[] = {&o->box_cycles, &o->tri_cycles, &o->fetch_latency, &o->dram_bytes_per_cycle,
+                           &o->clock_mhz, &o->rays_in_flight, &o->cache_hit_latency, &o->cache_ways,
+                           &o->unit_cycle_scale, &o->dram_pj_per_byte, &o->sram_pj_per_word, &o->issue_width};
+    double *dst[] = {&tp->box_cycles, &tp->tri_cycles, &tp->fetch_latency, &tp->dram_bytes_per_cycle,
+                     &tp->clock_mhz, &tp->rays_in_flight, &tp->cache_hit_latency, &tp->cache_ways,
+                     &tp->unit_cycle_scale, &tp->dram_pj_per_byte, &tp->sram_pj_per_word, &tp->issue_width};
+    for (size_t i = 0; i < sizeof src / sizeof src[0]; i++)
+        if (!isnan(*src[i])) *dst[i] = *src[i];
+}
+
+int cbvh_fx_add_rep(cbvh_fx_result *main, const cbvh_fx_result *rep) {
+    if (rep->hit_digest != main->hit_digest) return -1;
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        cbvh_fx_stats *s = &main->fx[e];
+        if (rep->fx[e].rays != s->rays) return -1;
+    }
+    for (int e = 0; e < CBVH_FX_COUNT; e++) {
+        cbvh_fx_stats *s = &main->fx[e];
+        if (s->nreps < CBVH_REPS_MAX) s->cpu_rep[s->nreps++] = rep->fx[e].cpu_seconds;
+    }
+    return 0;
+}
+
+int cbvh_fx_units(const cbvh_fx_result *r, const cbvh_cost_table *t, const cbvh_timing_params *tp,
+                  const char *box_unit, int n, int m, cbvh_timing_units *u, char *err, size_t errlen) {
+    cbvh_fx_stats s = cbvh_fx_total(r);
+    const char *node = s.ops.ray_sphere || strncmp(r->format, "tlist", 5) == 0 ? "ray_sphere" : box_unit;
+    return cbvh_timing_units_for(t, tp, node, (r->format_flags & CBVH_FORMAT_USES_N) != 0,
+                                 (r->format_flags & CBVH_FORMAT_STACK_UNIT) != 0, n, m, u, err, errlen);
 }
 

@@ -12,6 +12,7 @@
 #include "cbvh/format.h"
 #include "cbvh/traverse.h"
 #include "scene/scene_file.h"
+#include "trace/memsim.h"
 #include "trace/metrics.h"
 #include "trace/timing_model.h"
 
@@ -37,6 +38,14 @@ typedef struct {
     void (*progress)(void *ctx, int frame, int frames, int row, int rows); /* optional */
     void *ctx;
     int one_sided;         /* triangles count only from their front side (cbvh_tri_facing), every format */
+    /* The timing model's caches (docs/timing_model.md §3): ncaches sizes in KB
+     * (0: none, INFINITY: infinite), cache_ways ways; with ncaches = 0 no read
+     * is observed.  steps: optional, each ray's steps for the event-driven
+     * check (trace/memsim.h). */
+    const double *cache_kb;
+    int ncaches;
+    int cache_ways;
+    cbvh_step_log *steps;
 } cbvh_fx_opts;
 
 /* A run: counters per effect (cbvh_fx_stats, trace/metrics.h) and invocations
@@ -55,6 +64,10 @@ typedef struct {
     uint64_t pixels_without_ray;
     uint64_t hit_digest;     /* hash of every ray's hit (prim, t bits) */
     double build_cpu_seconds;
+    double cache_kb[CBVH_CACHES_MAX]; /* the caches modelled (cbvh_fx_stats.mem) */
+    int ncaches;
+    unsigned format_flags;   /* the format's CBVH_FORMAT_* flags */
+    char format[CBVH_FORMAT_NAME_MAX]; /* its canonical spec */
 } cbvh_fx_result;
 
 /* Builds the chosen format from frame 0's triangles (cbvh/format.h) and for
@@ -69,5 +82,18 @@ cbvh_fx_stats cbvh_fx_total(const cbvh_fx_result *r);
 /* Timing-model parameters for a scene: the defaults with the scene file's
  * overrides (docs/timing_model.md). */
 void cbvh_fx_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp);
+
+/* One more timed repetition of a run: rep's CPU time per effect appended to
+ * main's (cbvh_fx_stats.cpu_rep), if rep traced the same rays with the same
+ * hits (else -1, nothing appended). */
+int cbvh_fx_add_rep(cbvh_fx_result *main, const cbvh_fx_result *rep);
+
+/* The units of a run's format (trace/timing_model.h): the node unit is the
+ * sphere unit for the traversal lists, else box_unit ("ray_box" or
+ * "ray_box_incr"); the decoder for a format with N (the CBVH), the stack
+ * unit for one that runs it (the QBVH).  n, m: the design point.  0, or -1
+ * with a one-line reason. */
+int cbvh_fx_units(const cbvh_fx_result *r, const cbvh_cost_table *t, const cbvh_timing_params *tp,
+                  const char *box_unit, int n, int m, cbvh_timing_units *u, char *err, size_t errlen);
 
 #endif

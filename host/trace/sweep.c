@@ -9,6 +9,8 @@
 
 #include "cbvh/oom.h"
 
+const cbvh_box_unit cbvh_box_units[CBVH_BOX_UNITS] = {{"exact", "ray_box"}};
+
 /* What the float reference returned for one ray. */
 typedef struct {
     uint32_t prim, t;
@@ -28,6 +30,7 @@ typedef struct {
     uint64_t n;     /* rays seen in this run */
     double *shade;  /* width*height accumulated shade (frame 0) */
     int spp;
+    int rep; /* 0: the traced pass; k: the k-th timed repetition */
 } sweep_ctx;
 
 static void *xcalloc(size_t n, size_t sz) {
@@ -69,6 +72,7 @@ static void on_ray(void *vctx, const cbvh_fx_ray *fr) {
     if (fr->effect == CBVH_FX_PRIMARY && fr->frame == 0) {
         size_t p = (size_t)fr->py * (size_t)w + (size_t)fr->px;
         run->box_px[p] += (double)fr->st->box_tests / c->spp;
+        run->tri_px[p] += (double)fr->st->tri_tests / c->spp;
         if (h.hit) c->shade[p] += shade_hit(&c->tris0[h.prim], &fr->ray) / c->spp;
     }
     if (c->setting < 0) {
@@ -114,12 +118,13 @@ static void on_progress(void *vctx, int frame, int frames, int row, int rows) {
     sweep_ctx *c = vctx;
     (void)frame;
     (void)frames;
-    if (c->o->progress) c->o->progress(c->o->ctx, c->label, c->setting + 1, c->nsettings, row, rows);
+    if (c->o->progress) c->o->progress(c->o->ctx, c->label, c->setting + 1, c->nsettings, row, rows, c->rep);
 }
 
 static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char *err, size_t errlen) {
     size_t npx = (size_t)c->d->camera.width * (size_t)c->d->camera.height;
     run->box_px = xcalloc(npx, sizeof *run->box_px);
+    run->tri_px = xcalloc(npx, sizeof *run->tri_px);
     run->image = xcalloc(npx, 1);
     c->shade = xcalloc(npx, sizeof *c->shade);
     c->run = run;
@@ -133,6 +138,9 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char
                        .progress = on_progress,
                        .ctx = c};
     fo.one_sided = c->o->one_sided;
+    fo.cache_kb = c->o->cache_kb;
+    fo.ncaches = c->o->ncaches;
+    fo.cache_ways = c->o->cache_ways;
     int rc = cbvh_fx_run(c->d, &fo, &run->r, err, errlen);
     for (size_t p = 0; p < npx; p++) {
         double v = floor(c->shade[p] + 0.5);
@@ -141,6 +149,37 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char
     free(c->shade);
     c->shade = NULL;
     return rc;
+}
+
+/* The CPU-time column: every configuration traced `reps` more times without
+ * the caches or the observer, the configurations in turn within each
+ * repetition (so a drift of the machine's speed hits them alike). */
+static int timed_reps(sweep_ctx *c, cbvh_sweep_result *res, char *err, size_t errlen) {
+    const cbvh_sweep_opts *o = c->o;
+    int total = res->nrows + res->nextra;
+    for (int k = 1; k <= o->reps; k++)
+        for (int i = -1; i < total; i++) {
+            cbvh_sweep_run_t *run = i < 0 ? &res->ref : i < res->nrows ? &res->rows[i] : &res->extra[i - res->nrows];
+            const char *fmt = i < 0 ? "float" : i < res->nrows ? "cbvh" : o->extra[i - res->nrows].name;
+            c->setting = i;
+            c->rep = k;
+            c->label = fmt;
+            cbvh_fx_opts fo = {.format = fmt,
+                               .params = {run->s.bits ? run->s.bits : 6, run->s.min_scale},
+                               .mant = run->s.mant,
+                               .spp = o->spp,
+                               .progress = on_progress,
+                               .ctx = c,
+                               .one_sided = o->one_sided};
+            cbvh_fx_result rep;
+            if (cbvh_fx_run(c->d, &fo, &rep, err, errlen)) return -1;
+            if (cbvh_fx_add_rep(&run->r, &rep)) {
+                snprintf(err, errlen, "repetition %d of %s traced other rays or hits than its first pass", k, fmt);
+                return -1;
+            }
+        }
+    c->rep = 0;
+    return 0;
 }
 
 /* After a run: the same number of rays as the reference and the same image. */
@@ -201,14 +240,14 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
     for (int m = 0; m < o->nmant; m++)
         for (int e = 0; e < o->nmin_scale; e++)
             for (int b = o->bits_lo; b <= o->bits_hi; b++)
-                res->rows[k++].s = (cbvh_sweep_setting){b, o->mant[m], o->min_scale[e]};
+                res->rows[k++].s = (cbvh_sweep_setting){b, o->mant[m], o->min_scale[e], 0};
 
     cbvh_tri *tris0 = xcalloc(d->mesh.ntris, sizeof *tris0);
     cbvh_scene_desc_frame(d, 0, tris0);
     sweep_ctx c = {.d = d, .o = o, .tris0 = tris0, .setting = -1, .nsettings = res->nrows + o->nextra, .label = "float",
                    .spp = res->spp};
     int rc = -1;
-    res->ref.s = (cbvh_sweep_setting){0, CBVH_MANT_MAX, o->min_scale[0]};
+    res->ref.s = (cbvh_sweep_setting){0, CBVH_MANT_MAX, o->min_scale[0], 0};
     if (run_one(&c, &res->ref, "float", err, errlen)) goto out;
     res->ref_rays = c.nrec;
     if (o->corrupt_setting >= 0 && o->corrupt_ray >= c.nrec) { /* a fault that never fires would pass */
@@ -231,13 +270,14 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
         const cbvh_sweep_format *f = &o->extra[k];
         cbvh_sweep_run_t *run = &res->extra[k];
         res->nextra = k + 1;
-        run->s = (cbvh_sweep_setting){0, o->mant[0], o->min_scale[0]};
+        run->s = (cbvh_sweep_setting){0, o->mant[0], o->min_scale[0], 0};
         cbvh_sweep_format_label(f, run->s.mant, label, sizeof label);
         c.setting = res->nrows + k;
         c.label = label;
         if (run_one(&c, run, f->name, err, errlen)) goto out;
         check_totals(&c, run, res);
     }
+    if (timed_reps(&c, res, err, errlen)) goto out;
     rc = 0;
 out:
     free(c.rec);
@@ -248,27 +288,52 @@ out:
 
 void cbvh_sweep_free(cbvh_sweep_result *res) {
     free(res->ref.box_px);
+    free(res->ref.tri_px);
     free(res->ref.image);
     for (int i = 0; res->rows && i < res->nrows; i++) {
         free(res->rows[i].box_px);
+        free(res->rows[i].tri_px);
         free(res->rows[i].image);
     }
     free(res->rows);
     for (int k = 0; k < res->nextra; k++) {
         free(res->extra[k].box_px);
+        free(res->extra[k].tri_px);
         free(res->extra[k].image);
     }
     memset(res, 0, sizeof *res);
 }
 
-void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, double out[SWEEP_NMETRICS]) {
+void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_machine *mc, double out[SWEEP_NMETRICS]) {
     cbvh_ray_metrics m;
-    cbvh_ray_metrics_of(s, tp, &m);
+    cbvh_ray_metrics_of(s, mc, &m);
     out[SWEEP_BOX] = m.box;
     out[SWEEP_TRI] = m.tri;
     out[SWEEP_BYTES] = m.bytes;
     out[SWEEP_MODEL_NS] = m.model_ns;
     out[SWEEP_CPU_US] = m.cpu_us;
+    out[SWEEP_ENERGY] = m.energy_nj;
+}
+
+void cbvh_pareto_front(const double (*cost)[3], int n, int *front) {
+    for (int i = 0; i < n; i++) {
+        const double *a = cost[i];
+        front[i] = !isnan(a[0]) && !isnan(a[1]) && !isnan(a[2]);
+        for (int j = 0; j < n && front[i]; j++) {
+            const double *b = cost[j];
+            if (j == i || isnan(b[0]) || isnan(b[1]) || isnan(b[2])) continue;
+            int le = b[0] <= a[0] && b[1] <= a[1] && b[2] <= a[2];
+            int lt = b[0] < a[0] || b[1] < a[1] || b[2] < a[2];
+            if (le && lt) front[i] = 0;
+        }
+    }
+}
+
+int cbvh_argmin(const double *v, int n) {
+    int k = -1;
+    for (int i = 0; i < n; i++)
+        if (isfinite(v[i]) && (k < 0 || v[i] < v[k])) k = i;
+    return k;
 }
 
 const cbvh_format *cbvh_sweep_format_find(const char *spec) {

@@ -44,10 +44,22 @@ void cbvh_sweep_format_label(const cbvh_sweep_format *f, int mant, char *out, si
  * (one, without options: its title), " and the other formats". */
 const char *cbvh_sweep_others(const cbvh_sweep_format *extra, int nextra, char *buf, size_t n);
 
+/* The box units a sweep models, by index: the name in tables and the unit
+ * of the RTL cost table (trace/cost_table.h).  The exact unit (unit 6) is
+ * the one the traversals run today; the incremental unit of seed 003's
+ * Eq. 5 (issue 35, cost-table unit "ray_box_incr") becomes one more entry
+ * when its traversal lands. */
+typedef struct {
+    const char *name, *cost_unit;
+} cbvh_box_unit;
+#define CBVH_BOX_UNITS 1
+extern const cbvh_box_unit cbvh_box_units[CBVH_BOX_UNITS];
+
 typedef struct {
     int bits; /* N; 0 = the float BVH */
     int mant; /* M of the ray-box unit */
     int min_scale;
+    int box_unit; /* index into cbvh_box_units */
 } cbvh_sweep_setting;
 
 typedef struct {
@@ -58,13 +70,21 @@ typedef struct {
     cbvh_sweep_format extra[CBVH_SWEEP_MAX_EXTRA]; /* traced after the CBVH settings (M = mant[0]) */
     int nextra;
     int one_sided; /* triangles count only from their front side, every format (required by tlist culling) */
+    /* The timing model's caches: every setting is traced once with ncaches
+     * cache sizes in KB (0: none, INFINITY) of cache_ways ways; then `reps`
+     * more times without them for the CPU-time column (0: none). */
+    double cache_kb[CBVH_CACHES_MAX];
+    int ncaches, cache_ways;
+    int reps;
     /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows +
      * k = extra format k, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
      * for a closest hit, the opposite answer for an any-hit ray); a ray the
      * float BVH did not trace is an error of cbvh_sweep_run. */
     int corrupt_setting;
     uint64_t corrupt_ray;
-    void (*progress)(void *ctx, const char *label, int setting, int settings, int row, int rows);
+    /* Progress: setting (1-based; 0 the float BVH) of settings, camera row of
+     * rows; rep: 0 for the traced pass, then the timed repetition 1..reps. */
+    void (*progress)(void *ctx, const char *label, int setting, int settings, int row, int rows, int rep);
     void *ctx;
 } cbvh_sweep_opts;
 
@@ -73,6 +93,7 @@ typedef struct {
     cbvh_sweep_setting s;
     cbvh_fx_result r;
     double *box_px; /* width*height: box tests of the primary rays per pixel (frame 0, mean over samples) */
+    double *tri_px; /* width*height: their triangle tests, likewise */
     uint8_t *image; /* width*height grey: shaded primary hits (frame 0, mean over samples) */
     /* Identity with the float reference (always 1 for the reference itself). */
     int same;
@@ -98,10 +119,20 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
                    size_t errlen);
 void cbvh_sweep_free(cbvh_sweep_result *res);
 
-/* Per-ray costs of a set of rays (cbvh_ray_metrics_of) indexed for the
- * sweep's loops over costs. */
-enum { SWEEP_BOX = 0, SWEEP_TRI, SWEEP_BYTES, SWEEP_MODEL_NS, SWEEP_CPU_US, SWEEP_NMETRICS };
-void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_timing_params *tp, double out[SWEEP_NMETRICS]);
+/* Per-ray costs of a set of rays (cbvh_ray_metrics_of on machine mc)
+ * indexed for the sweep's loops over costs. */
+enum { SWEEP_BOX = 0, SWEEP_TRI, SWEEP_BYTES, SWEEP_MODEL_NS, SWEEP_CPU_US, SWEEP_ENERGY, SWEEP_NMETRICS };
+void cbvh_sweep_per_ray(const cbvh_fx_stats *s, const cbvh_machine *mc, double out[SWEEP_NMETRICS]);
+
+/* The Pareto front of n points of three costs to minimise (time, energy,
+ * area): front[i] = 1 iff no other point is at most as costly in all three
+ * and cheaper in one.  A point with a NaN cost is never on it nor dominates;
+ * equal points are all on it. */
+void cbvh_pareto_front(const double (*cost)[3], int n, int *front);
+
+/* The index of the smallest finite value of v[0..n) (ties: the first), -1
+ * if none. */
+int cbvh_argmin(const double *v, int n);
 
 /* The knee of one cost curve: rel[i] is the relative cost at bits[i]
  * (ascending).  Returns the smallest bits[k] such that rel[j] <= (1 + tol) *

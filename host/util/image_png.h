@@ -23,14 +23,36 @@ int cbvh_png_write_stream(FILE *f, const uint8_t *pix, unsigned w, unsigned h, i
  * -> purple -> orange -> pale yellow, monotone in luminance. */
 void cbvh_colormap(double t, uint8_t rgb[3]);
 
-/* Heat map of a scalar per pixel (e.g. box tests per pixel): values mapped
- * linearly from [vmin, vmax] to the colour map (vmin >= vmax: the data's own
- * range), then a legend strip under the image: a 4-pixel gap and a gradient
- * from vmin (left) to vmax (right), legend_h rows (0: max(8, h / 12)).  The
- * range used is stored as tEXt chunks "legend_min" / "legend_max" and
- * returned in *used_min / *used_max (may be NULL).  Non-finite values are an
- * error. */
-int cbvh_heatmap_png(const char *path, const double *val, unsigned w, unsigned h, double vmin, double vmax,
-                     unsigned legend_h, double *used_min, double *used_max, char *err, size_t errlen);
+/* The diverging colour map of difference heat maps: t in [0, 1] (clamped;
+ * NaN -> 0.5) to RGB, blue (0) -> white (0.5) -> red (1). */
+void cbvh_colormap_diverging(double t, uint8_t rgb[3]);
+
+/* How a heat map is drawn. */
+typedef struct {
+    const char *title;  /* a line above the map (printable ASCII; other bytes drawn as '?'); NULL: none */
+    const char *label;  /* a line under the colour bar: what a colour counts; NULL: none */
+    double vmin, vmax;  /* the value range of the colours; vmin >= vmax: the data's own range */
+    int diverging;      /* 1: the diverging map, the range made symmetric around 0 (max |v|) */
+    unsigned min_width; /* the map is scaled up by a whole factor, without smoothing, to at least this
+                           many pixels wide (0: 512) */
+} cbvh_heatmap_style;
+
+/* Where things went in a heat map. */
+typedef struct {
+    double vmin, vmax;      /* the range used */
+    unsigned scale;         /* pixels per value, each way */
+    unsigned width, height; /* the image */
+    unsigned map_x, map_y;  /* the map's top-left corner (its size: w x h times scale) */
+    unsigned bar_y, bar_h;  /* the colour bar: rows bar_y .. bar_y + bar_h - 1, columns map_x .. map_x + w*scale - 1 */
+} cbvh_heatmap_info;
+
+/* Heat map of a scalar per pixel (e.g. box tests per pixel) in a PNG: a
+ * white frame with the title, the map scaled up (st->min_width), under it a
+ * colour bar from vmin (left) to vmax (right) with five tick marks and
+ * their values, and the label.  The range is also stored as tEXt chunks
+ * "legend_min" / "legend_max", the title as "Title".  Non-finite values are
+ * an error.  info may be NULL. */
+int cbvh_heatmap_png(const char *path, const double *val, unsigned w, unsigned h, const cbvh_heatmap_style *st,
+                     cbvh_heatmap_info *info, char *err, size_t errlen);
 
 #endif

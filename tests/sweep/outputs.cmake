@@ -2,8 +2,11 @@
 # Runs a sweep with --json into a fresh directory and checks what it wrote:
 # exit 0, nothing on stderr (not a terminal: no progress), the JSON has the
 # expected settings and same_hits true, exactly the expected files (no temp
-# files left), every PNG readable by libpng at the image size, the SVG one
-# closed <svg> document.
+# files left), every PNG readable by libpng at its size (the render at the
+# camera's, the heat and difference maps scaled up to at least 512 pixels
+# wide in a 16-pixel frame), each SVG one closed <svg> document with its
+# series (cost: 4; time and energy: one per M and the float BVH), and the
+# timing model's figures in the JSON.
 file(REMOVE_RECURSE "${OUT}")
 execute_process(COMMAND "${CBVH}" sweep "${SCENE}" --bits 4..7 --mant 24 12 --json --out "${OUT}"
     --heatmap float 4 6:12:-30
@@ -31,14 +34,22 @@ string(JSON w GET "${out}" width)
 string(JSON h GET "${out}" height)
 file(GLOB files RELATIVE "${OUT}" "${OUT}/*")
 list(SORT files)
-set(expect cost-M12-E-30.svg cost-M24-E-30.svg heat-N4.png heat-N6-M12-E-30.png heat-float.png render-float.png)
+set(expect cost-M12-E-30.svg cost-M24-E-30.svg time-C64.svg energy-C64.svg heat-N4.png diff-N4.png
+    heat-N6-M12-E-30.png diff-N6-M12-E-30.png heat-float.png render-float.png)
 list(SORT expect)
 if(NOT files STREQUAL expect)
     message(FATAL_ERROR "files written: ${files}; expected: ${expect}")
 endif()
+math(EXPR scale "(512 + ${w} - 1) / ${w}")
+math(EXPR mw "${w} * ${scale} + 32")
+math(EXPR mh "${h} * ${scale}")
 foreach(f IN LISTS files)
     if(f MATCHES "\\.png$")
-        execute_process(COMMAND "${CHECK_PNG}" "${OUT}/${f}" ${w} ${h} RESULT_VARIABLE prc ERROR_VARIABLE perr)
+        if(f STREQUAL "render-float.png")
+            execute_process(COMMAND "${CHECK_PNG}" "${OUT}/${f}" ${w} ${h} RESULT_VARIABLE prc ERROR_VARIABLE perr)
+        else()
+            execute_process(COMMAND "${CHECK_PNG}" "${OUT}/${f}" ${mw} ${mh} RESULT_VARIABLE prc ERROR_VARIABLE perr)
+        endif()
         if(NOT prc EQUAL 0)
             message(FATAL_ERROR "bad PNG ${f}: ${perr}")
         endif()
@@ -50,9 +61,25 @@ foreach(f IN LISTS files)
         endif()
         string(REGEX MATCHALL "<polyline" lines "${svg}")
         list(LENGTH lines nl)
-        if(NOT nl EQUAL 4)
-            message(FATAL_ERROR "${f}: ${nl} series, expected 4")
+        if(f MATCHES "^cost")
+            set(want 4)
+        else()
+            set(want 3)
+        endif()
+        if(NOT nl EQUAL want)
+            message(FATAL_ERROR "${f}: ${nl} series, expected ${want}")
         endif()
     endif()
 endforeach()
+# The timing model: every configuration at the cache (64 KB), the units, the fastest.
+string(JSON ns GET "${out}" settings 7 total model 0 ns_per_ray)
+string(JSON kb GET "${out}" settings 7 total model 0 cache_kb)
+string(JSON hr GET "${out}" float total model 0 hit_rate)
+string(JSON bu GET "${out}" timing units box unit)
+string(JSON best GET "${out}" best 0 total)
+string(JSON reps GET "${out}" float total cpu_reps)
+if(NOT ns GREATER 0 OR NOT kb EQUAL 64 OR NOT hr GREATER 0 OR NOT bu STREQUAL "ray_box" OR best STREQUAL ""
+   OR NOT reps EQUAL 5)
+    message(FATAL_ERROR "timing model JSON: ns ${ns}, cache ${kb}, hit rate ${hr}, box unit ${bu}, best ${best}, reps ${reps}")
+endif()
 message(STATUS "ok: ${files}")

@@ -12,11 +12,13 @@
 
 #include <cmocka.h>
 
+#include "trace/model_eval.h"
 #include "trace/sweep.h"
 
 static cbvh_scene_desc scene;
 static cbvh_sweep_result res; /* bits 3..10 x M {24, 8} x E {-30} */
 static cbvh_timing_params tp;
+static cbvh_cost_table table;
 
 static int setup(void **state) {
     (void)state;
@@ -26,7 +28,12 @@ static int setup(void **state) {
         return -1;
     }
     cbvh_sweep_opts o = {.bits_lo = 3, .bits_hi = 10, .mant = {24, 8}, .nmant = 2, .min_scale = {-30},
-                         .nmin_scale = 1, .corrupt_setting = -1};
+                         .nmin_scale = 1, .corrupt_setting = -1, .cache_kb = {16, 0}, .ncaches = 2, .cache_ways = 8,
+                         .reps = 2};
+    if (cbvh_cost_table_load(COST_DIR, &table, err, sizeof err)) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
     if (cbvh_sweep_run(&scene, &o, &res, err, sizeof err)) {
         fprintf(stderr, "%s\n", err);
         return -1;
@@ -39,14 +46,27 @@ static int teardown(void **state) {
     (void)state;
     cbvh_sweep_free(&res);
     cbvh_scene_desc_free(&scene);
+    cbvh_cost_table_free(&table);
     return 0;
+}
+
+/* A run's machine at its first cache (16 KB) with the committed cost table. */
+static cbvh_machine machine(const cbvh_sweep_run_t *r) {
+    cbvh_config_model cm;
+    char err[256];
+    if (cbvh_config_model_init(&cm, &r->r, &table, &tp, "ray_box", r->s.bits ? r->s.bits : 6, r->s.mant, err,
+                               sizeof err))
+        fail_msg("%s", err);
+    assert_int_equal(cm.ncaches, 2);
+    return cm.mc[0];
 }
 
 static double rel_total(const cbvh_sweep_run_t *r, int metric) {
     cbvh_fx_stats a = cbvh_fx_total(&r->r), f = cbvh_fx_total(&res.ref.r);
     double p[SWEEP_NMETRICS], q[SWEEP_NMETRICS];
-    cbvh_sweep_per_ray(&a, &tp, p);
-    cbvh_sweep_per_ray(&f, &tp, q);
+    cbvh_machine ma = machine(r), mf = machine(&res.ref);
+    cbvh_sweep_per_ray(&a, &ma, p);
+    cbvh_sweep_per_ray(&f, &mf, q);
     return p[metric] / q[metric];
 }
 
@@ -85,6 +105,16 @@ static void test_relative_costs(void **state) {
     assert_true(b3 > b10 + 0.2);
     assert_true(t3 > t10 + 0.2);
     assert_true(rel_total(row(3, 24), SWEEP_MODEL_NS) > rel_total(row(10, 24), SWEEP_MODEL_NS));
+    /* The caches saw every setting's reads; the timed repetitions every configuration. */
+    for (int i = -1; i < res.nrows; i++) {
+        const cbvh_sweep_run_t *r = i < 0 ? &res.ref : &res.rows[i];
+        cbvh_fx_stats t = cbvh_fx_total(&r->r);
+        assert_true(t.mem[0].lines > 0 && t.mem[0].miss_lines < t.mem[0].lines);
+        assert_int_equal(t.mem[1].miss_lines, t.mem[1].lines); /* no cache */
+        assert_int_equal(t.nreps, 2);
+        assert_true(t.cpu_rep[0] > 0 && t.cpu_rep[1] > 0);
+        assert_int_equal(r->r.ncaches, 2);
+    }
     /* A narrower box unit only loosens the test: at least as much work. */
     for (int b = 3; b <= 10; b++) assert_true(rel_total(row(b, 8), SWEEP_BOX) >= rel_total(row(b, 24), SWEEP_BOX));
     /* Node memory: 16-byte pairs up to N = 6, 24-byte from N = 7, both below the float BVH. */

@@ -9,7 +9,7 @@
  *   - so does the QBVH (format qbvh), ray by ray, also after refits; only
  *     it runs the qbvh_stack unit;
  *   - scene-file errors give the right one-line message;
- *   - the timing model computes what its doc says on a hand-checked example. */
+ *   (the timing model's worked examples: tests/trace/test_timing.c) */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -608,6 +608,14 @@ static void errors(void **state) {
          "t.scene: timing.clock_mhz: 0 is out of range [0.001, 1e+09]"},
         {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"dram_bytes_per_cycle\": 1e-6}}",
          "t.scene: timing.dram_bytes_per_cycle: 1e-06 is out of range [0.001, 1e+09]"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"cache_ways\": 0}}",
+         "t.scene: timing.cache_ways: 0 is out of range [1, 64]"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"rays_in_flight\": 0}}",
+         "t.scene: timing.rays_in_flight: 0 is out of range [0.001, 1e+09]"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"issue_width\": 2000}}",
+         "t.scene: timing.issue_width: 2000 is out of range [1, 1024]"},
+        {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"timing\": {\"warp\": 1}}",
+         "t.scene: timing.warp: unknown field"},
         {"{\"mesh\": \"" MESH "\", " CAMERA ", \"effects\": [\"primary\"], \"shadows\": true}",
          "t.scene: shadows: unknown field"},
         {"[1, 2]", "t.scene: expected a JSON object at the top level"},
@@ -649,41 +657,11 @@ static void errors(void **state) {
     cbvh_scene_desc_free(&d);
 }
 
-/* docs/timing_model.md, worked example. */
-static void timing_example(void **state) {
-    (void)state;
-    cbvh_timing_params p = {2, 5, 100, 12.8, 500};
-    cbvh_timing_work w = {10, 3, 4, 640};
-    cbvh_timing_result r;
-    assert_int_equal(cbvh_timing_eval(&p, &w, &r), 0);
-    assert_float_equal(r.compute_cycles, 35.0, 1e-12);   /* 10*2 + 3*5 */
-    assert_float_equal(r.latency_cycles, 700.0, 1e-12);  /* (4 + 3) * 100 */
-    assert_float_equal(r.transfer_cycles, 50.0, 1e-12);  /* 640 / 12.8 */
-    assert_float_equal(r.cycles, 785.0, 1e-12);
-    assert_float_equal(r.seconds, 1.57e-6, 1e-18);       /* 785 / 500 MHz */
-    cbvh_timing_params dflt;
-    cbvh_timing_defaults(&dflt);
-    assert_float_equal(dflt.box_cycles, 1.0, 0);
-    assert_float_equal(dflt.tri_cycles, 1.0, 0);
-    assert_float_equal(dflt.fetch_latency, 100.0, 0);
-    assert_float_equal(dflt.dram_bytes_per_cycle, 12.8, 0);
-    assert_float_equal(dflt.clock_mhz, 1000.0, 0);
-    assert_int_equal(cbvh_timing_eval(&dflt, &w, &r), 0);
-    assert_float_equal(r.cycles, 10 + 3 + 700 + 50, 1e-12);
-    assert_float_equal(r.seconds, 763e-9, 1e-18);
-    cbvh_timing_params bad = p;
-    bad.dram_bytes_per_cycle = 0;
-    assert_int_equal(cbvh_timing_eval(&bad, &w, &r), -1);
-    bad = p;
-    bad.box_cycles = -1;
-    assert_int_equal(cbvh_timing_eval(&bad, &w, &r), -1);
-}
-
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(primary_only), cmocka_unit_test(all_effects), cmocka_unit_test(no_mirror_material),
         cmocka_unit_test(animated_refits), cmocka_unit_test(cameras), cmocka_unit_test(errors),
-        cmocka_unit_test(timing_example), cmocka_unit_test(qbvh_all_effects), cmocka_unit_test(qbvh_effects_obeyed),
+        cmocka_unit_test(qbvh_all_effects), cmocka_unit_test(qbvh_effects_obeyed),
         cmocka_unit_test(qbvh_animated), cmocka_unit_test(tlist_all_effects), cmocka_unit_test(tlist_heads_save_work),
         cmocka_unit_test(tlist_animated), cmocka_unit_test(tlist_options),
     };

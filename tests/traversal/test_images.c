@@ -114,6 +114,17 @@ static void png_bad_input(void **state) {
     assert_int_equal(files_in_dir(), 0);
 }
 
+/* A pixel of an RGB image. */
+static const uint8_t *px(const uint8_t *img, unsigned w, unsigned x, unsigned y) { return img + ((size_t)y * w + x) * 3; }
+
+/* Any black (text) pixel in rows y0 .. y1 - 1. */
+static int has_ink(const uint8_t *img, unsigned w, unsigned y0, unsigned y1) {
+    for (unsigned y = y0; y < y1; y++)
+        for (unsigned x = 0; x < w; x++)
+            if (!px(img, w, x, y)[0] && !px(img, w, x, y)[1] && !px(img, w, x, y)[2]) return 1;
+    return 0;
+}
+
 static void heatmap(void **state) {
     (void)state;
     char p[300], err[256];
@@ -122,34 +133,58 @@ static void heatmap(void **state) {
     for (unsigned y = 0; y < H; y++)
         for (unsigned x = 0; x < W; x++) v[y * W + x] = 10 + x + 0.5 * y; /* min 10 at (0,0), max at (63,47) */
     snprintf(p, sizeof p, "%s/heat.png", dir);
-    double lo, hi;
-    assert_int_equal(cbvh_heatmap_png(p, v, W, H, 0, 0, 10, &lo, &hi, err, sizeof err), 0);
-    assert_true(lo == 10 && hi == 10 + 63 + 23.5);
+    cbvh_heatmap_style st = {"N=6 M=24: box tests", "box tests per pixel", 0, 0, 0, 0};
+    cbvh_heatmap_info in;
+    assert_int_equal(cbvh_heatmap_png(p, v, W, H, &st, &in, err, sizeof err), 0);
+    assert_true(in.vmin == 10 && in.vmax == 10 + 63 + 23.5);
+    assert_int_equal(in.scale, 8); /* 64 x 8 = 512: the smallest whole factor to 512 pixels wide */
     unsigned w, h;
     uint8_t *img = read_png(p, &w, &h, PNG_FORMAT_RGB);
     assert_non_null(img);
-    assert_int_equal(w, W);
-    assert_int_equal(h, H + 4 + 10);
+    assert_int_equal(w, in.width);
+    assert_int_equal(h, in.height);
+    assert_true(w >= 512 && w == W * 8 + 2 * in.map_x);
     uint8_t c0[3], c1[3];
     cbvh_colormap(0, c0);
     cbvh_colormap(1, c1);
-    assert_memory_equal(img, c0, 3);                                   /* min pixel */
-    assert_memory_equal(img + ((size_t)(H - 1) * W + W - 1) * 3, c1, 3); /* max pixel */
-    size_t strip = (size_t)(H + 4 + 5) * W * 3;                         /* a legend row */
-    assert_memory_equal(img + strip, c0, 3);
-    assert_memory_equal(img + strip + (W - 1) * 3, c1, 3);
-    assert_true(img[(size_t)(H + 1) * W * 3] == 255); /* white gap */
-    /* luminance grows along the legend */
+    /* Scaled without smoothing: the whole 8 x 8 block of value (0,0) is the min colour, of (63,47) the max. */
+    for (unsigned dy = 0; dy < 8; dy++)
+        for (unsigned dx = 0; dx < 8; dx++) {
+            assert_memory_equal(px(img, w, in.map_x + dx, in.map_y + dy), c0, 3);
+            assert_memory_equal(px(img, w, in.map_x + 63 * 8 + dx, in.map_y + 47 * 8 + dy), c1, 3);
+        }
+    /* The colour bar: min at its left end, max at its right, luminance growing along it. */
+    unsigned bar = in.bar_y + in.bar_h / 2;
+    assert_memory_equal(px(img, w, in.map_x, bar), c0, 3);
+    assert_memory_equal(px(img, w, in.map_x + W * 8 - 1, bar), c1, 3);
     double prev = -1;
-    for (unsigned x = 0; x < W; x++) {
-        const uint8_t *q = img + strip + x * 3;
+    for (unsigned x = in.map_x; x < in.map_x + W * 8; x++) {
+        const uint8_t *q = px(img, w, x, bar);
         double lum = 0.2126 * q[0] + 0.7152 * q[1] + 0.0722 * q[2];
         assert_true(lum >= prev - 0.5);
         prev = lum;
     }
+    /* Text: the title above the map, the tick values and the label below the bar; white around. */
+    assert_true(has_ink(img, w, 0, in.map_y));
+    assert_true(has_ink(img, w, in.bar_y + in.bar_h, h));
+    assert_false(has_ink(img, w, in.map_y, in.map_y + H * 8)); /* no text over the map */
+    assert_true(px(img, w, 0, in.map_y)[0] == 255);              /* white frame */
+    free(img);
+    /* Without a title the map starts higher; a diverging map is symmetric around 0, white at 0. */
+    cbvh_heatmap_style ds = {NULL, NULL, 0, 0, 1, 100};
+    for (unsigned i = 0; i < W * H; i++) v[i] = i % 3 == 0 ? -2.0 : i % 3 == 1 ? 0.0 : 5.0;
+    assert_int_equal(cbvh_heatmap_png(p, v, W, H, &ds, &in, err, sizeof err), 0);
+    assert_true(in.vmin == -5 && in.vmax == 5);
+    assert_int_equal(in.scale, 2);
+    img = read_png(p, &w, &h, PNG_FORMAT_RGB);
+    assert_non_null(img);
+    uint8_t white[3] = {255, 255, 255}, red[3];
+    cbvh_colormap_diverging(1, red);
+    assert_memory_equal(px(img, w, in.map_x + 2, in.map_y), white, 3); /* v[1] = 0 */
+    assert_memory_equal(px(img, w, in.map_x + 4, in.map_y), red, 3);   /* v[2] = 5 */
     free(img);
     v[5] = NAN;
-    assert_int_equal(cbvh_heatmap_png(p, v, W, H, 0, 0, 0, NULL, NULL, err, sizeof err), -1);
+    assert_int_equal(cbvh_heatmap_png(p, v, W, H, NULL, NULL, err, sizeof err), -1);
     assert_non_null(strstr(err, "not finite"));
     free(v);
 }

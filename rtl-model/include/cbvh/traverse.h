@@ -17,7 +17,7 @@
 #define CBVH_TRAV_STACK 256 /* entries; deeper trees are an error (-1) */
 #define CBVH_LINE_BYTES 64
 
-typedef struct {
+typedef struct cbvh_trav_stats {
     uint64_t nodes;      /* inner nodes whose node pair was fetched */
     uint64_t box_tests;  /* ray-box unit invocations (root box included) */
     uint64_t tri_tests;  /* ray-triangle unit invocations */
@@ -28,6 +28,26 @@ typedef struct {
     uint64_t qstack_pushes; /* sort + push operations: one per inner node visited */
     uint64_t qstack_pops;   /* pop operations */
 } cbvh_trav_stats;
+
+/* An observer of the traversals' memory reads, for a cache and timing model
+ * (host/trace, docs/timing_model.md).  Every read the `lines` counter counts
+ * is reported once: its kind, its byte address and size in the format's
+ * memory image as hardware would store it (docs/traversal.md §5; the QBVH
+ * reports its node as one 4-child record, docs/qbvh.md §3), and the ray's
+ * counters so far (box and triangle tests before this read).  Kinds: a node
+ * (node pair, QBVH node, list sphere element), primitive IDs (or a list's
+ * triangle element: the entry that names the triangle), a triangle. */
+typedef enum { CBVH_FETCH_NODE = 0, CBVH_FETCH_IDS = 1, CBVH_FETCH_TRI = 2 } cbvh_fetch_kind;
+typedef struct {
+    void (*fetch)(void *ctx, cbvh_fetch_kind kind, uint64_t addr, uint64_t size, const struct cbvh_trav_stats *so_far);
+    void *ctx;
+} cbvh_fetch_observer;
+
+/* The observer every traversal reports to (NULL, the default: none; the
+ * traversals then pay one test of a global per read).  Set it before tracing,
+ * not while other threads trace; o must outlive its use. */
+void cbvh_trav_set_observer(const cbvh_fetch_observer *o);
+extern const cbvh_fetch_observer *cbvh_trav_observer;
 
 typedef struct {
     int hit;

@@ -57,10 +57,16 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
     qs.tris = tris;
     qs.mode = mode;
     qs.M = mant_bits;
-    /* Memory image: bmin (16 B/node), bmax (16 B/node), info (8 B/node), IDs, triangles. */
+    /* Memory image of the counters: bmin (16 B/node), bmax (16 B/node), info
+     * (8 B/node), IDs, triangles.  The observer sees a node as hardware would
+     * store it (docs/qbvh.md §3): its children's boxes and info words side by
+     * side, 32 B per child, in a 128-byte record at first-child index x 128
+     * (one line for up to two children, two for three or four); the IDs and
+     * triangles after the records.  Moving a line-aligned region does not
+     * change the line counts. */
     const uint64_t bmin_base = 0, bmax_base = trav_align((uint64_t)q->nnodes * 16u),
                    info_base = bmax_base + trav_align((uint64_t)q->nnodes * 16u);
-    qs.ids_base = info_base + trav_align((uint64_t)q->nnodes * 8u);
+    qs.ids_base = trav_align((uint64_t)q->nnodes * 128u);
     qs.tris_base = trav_align(qs.ids_base + (uint64_t)q->nprims * 4u);
 
     uint32_t s32[CBVH_TRAV_STACK];
@@ -80,9 +86,10 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
                 goto finish;
             }
             qs.s.nodes++;
-            trav_fetch(&qs, bmin_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
-            trav_fetch(&qs, bmax_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u);
-            trav_fetch(&qs, info_base + (uint64_t)f * 8u, (uint64_t)cnt * 8u);
+            trav_observe(&qs, CBVH_FETCH_NODE, (uint64_t)f * 128u, (uint64_t)cnt * 32u);
+            qs.s.lines += cbvh_lines_touched(bmin_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u) +
+                          cbvh_lines_touched(bmax_base + (uint64_t)f * 16u, (uint64_t)cnt * 16u) +
+                          cbvh_lines_touched(info_base + (uint64_t)f * 8u, (uint64_t)cnt * 8u);
             uint32_t t[4] = {0, 0, 0, 0}, mask = 0;
             for (uint32_t c = 0; c < cnt; c++) {
                 cbvh_box_result cr;
@@ -123,7 +130,7 @@ int cbvh_trace_qbvh(const cbvh_qbvh *q, const cbvh_tri *tris, const cbvh_ray *ra
             }
         } else {
             uint32_t c = cnt & ~CBVH_QBVH_LEAF, p = q->first[node];
-            trav_fetch(&qs, qs.ids_base + (uint64_t)p * 4u, (uint64_t)c * 4u);
+            trav_fetch(&qs, CBVH_FETCH_IDS, qs.ids_base + (uint64_t)p * 4u, (uint64_t)c * 4u);
             for (uint32_t i = 0; i < c && !qs.done; i++) trav_triangle(&qs, q->prims[p + i]);
             if (qs.done) break;
         }

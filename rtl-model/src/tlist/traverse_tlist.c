@@ -33,8 +33,10 @@ int cbvh_trace_tlist(const cbvh_tlists *L, int l, uint32_t head, const cbvh_tri 
     cbvh_ray cut = *ray;
     for (uint32_t i = head; i < n;) {
         const cbvh_tlist_elem *e = &E[i];
-        trav_fetch(&ts, base + (uint64_t)i * CBVH_TLIST_ELEM_BYTES, CBVH_TLIST_ELEM_BYTES);
         int32_t esc = e->escape;
+        /* a triangle element names its triangle, as an ID entry does */
+        trav_fetch(&ts, esc == 1 || esc == 0 ? CBVH_FETCH_IDS : CBVH_FETCH_NODE,
+                   base + (uint64_t)i * CBVH_TLIST_ELEM_BYTES, CBVH_TLIST_ELEM_BYTES);
         if (esc == 1 || esc == 0) {
             trav_triangle(&ts, e->data[0]);
             if (ts.done || esc == 0) break;

@@ -69,7 +69,7 @@ int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray,
         if (cbvh_bvh_is_leaf(n)) {
             /* start the leaf's triangle loads together (memory latency) */
             for (uint32_t i = 0; i < n->count; i++) __builtin_prefetch(&tris[b->prims[n->first + i]]);
-            trav_fetch(&ts, ts.ids_base + (uint64_t)n->first * 4u, (uint64_t)n->count * 4u);
+            trav_fetch(&ts, CBVH_FETCH_IDS, ts.ids_base + (uint64_t)n->first * 4u, (uint64_t)n->count * 4u);
             for (uint32_t i = 0; i < n->count && !ts.done; i++) trav_triangle(&ts, b->prims[n->first + i]);
             if (ts.done) break;
             cull = trav_box_tmax(&ts);
@@ -77,7 +77,7 @@ int cbvh_trace_bvh(const cbvh_bvh *b, const cbvh_tri *tris, const cbvh_ray *ray,
             continue;
         }
         ts.s.nodes++;
-        trav_fetch(&ts, (uint64_t)ni * 64u, 64u);
+        trav_fetch(&ts, CBVH_FETCH_NODE, (uint64_t)ni * 64u, 64u);
         uint32_t c0 = n->child[0], c1 = n->child[1];
         const cbvh_bvh_node *n0 = &nodes[c0], *n1 = &nodes[c1];
         double pl[2][3][2], tn2[2]; /* [lower, upper][axis][child] */

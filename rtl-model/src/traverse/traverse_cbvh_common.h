@@ -34,7 +34,7 @@ static inline int trav_cbvh_leaf(trav_state *ts, const cbvh_tree *t, uint32_t fi
         if (t->ids[i] & CBVH_ID_LAST) break;
     }
     for (uint32_t i = first; i < t->nids && !ts->done; i++) {
-        trav_fetch(ts, ts->ids_base + (uint64_t)i * 4u, 4u);
+        trav_fetch(ts, CBVH_FETCH_IDS, ts->ids_base + (uint64_t)i * 4u, 4u);
         trav_triangle(ts, t->ids[i] & ~CBVH_ID_LAST);
         if (t->ids[i] & CBVH_ID_LAST) break;
     }

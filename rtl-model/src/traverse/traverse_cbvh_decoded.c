@@ -62,7 +62,7 @@ int cbvh_cbvh_decode_leaves(cbvh_cbvh_decoded *d, const cbvh_tri *tris, uint32_t
 static int leaf_copy(trav_state *ts, const cbvh_cbvh_dtri *lt, uint32_t nids, uint32_t first, cbvh_f32 *cull,
                      double *cull_d) {
     for (uint32_t i = first; i < nids && !ts->done; i++) {
-        trav_fetch(ts, ts->ids_base + (uint64_t)i * 4u, 4u);
+        trav_fetch(ts, CBVH_FETCH_IDS, ts->ids_base + (uint64_t)i * 4u, 4u);
         trav_triangle_v(ts, lt[i].id & ~CBVH_ID_LAST, (const cbvh_f32(*)[3])lt[i].v);
         if (lt[i].id & CBVH_ID_LAST) break;
     }
@@ -238,6 +238,7 @@ int cbvh_trace_cbvh_decoded(const cbvh_cbvh_decoded *d, const cbvh_tri *tris, co
         ts.s.nodes++; /* the decode visited each pair once: no cycle, no pointer out of range */
         const cbvh_cbvh_dnode *rec = &d->nodes[p];
         uint32_t fl = rec->flags;
+        trav_observe(&ts, CBVH_FETCH_NODE, (uint64_t)p * t->pair_bytes, t->pair_bytes);
         ts.s.lines += 1u + !!(fl & CBVH_DEC_2LINES); /* trav_fetch of the pair's bytes */
         for (int c = 0; c < 2; c++) { /* start the children's loads before their box tests */
             uint32_t q = rec->child[c];

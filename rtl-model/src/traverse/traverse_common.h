@@ -65,8 +65,16 @@ static inline const cbvh_rb_ray *trav_prep(trav_state *ts) {
     return &ts->prep;
 }
 
-/* Lines read; bytes are whole lines, counted once at trav_finish. */
-static inline void trav_fetch(trav_state *ts, uint64_t addr, uint64_t size) {
+/* A read reported to the observer, if one is set (cbvh_trav_set_observer). */
+static inline void trav_observe(const trav_state *ts, cbvh_fetch_kind kind, uint64_t addr, uint64_t size) {
+    const cbvh_fetch_observer *o = cbvh_trav_observer;
+    if (__builtin_expect(o != NULL, 0)) o->fetch(o->ctx, kind, addr, size, &ts->s);
+}
+
+/* Lines read; bytes are whole lines, counted once at trav_finish.  The
+ * observer sees the same read. */
+static inline void trav_fetch(trav_state *ts, cbvh_fetch_kind kind, uint64_t addr, uint64_t size) {
+    trav_observe(ts, kind, addr, size);
     ts->s.lines += cbvh_lines_touched(addr, size);
 }
 
@@ -81,7 +89,7 @@ static inline cbvh_f32 trav_box_tmax(const trav_state *ts) {
 
 /* Triangle id with vertices v (ts->tris[id], or a copy of it). */
 static inline void trav_triangle_v(trav_state *ts, uint32_t id, const cbvh_f32 v[3][3]) {
-    trav_fetch(ts, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
+    trav_fetch(ts, CBVH_FETCH_TRI, ts->tris_base + (uint64_t)id * sizeof(cbvh_tri), sizeof(cbvh_tri));
     ts->s.tri_tests++;
     if (!ts->tprep_ready) {
         cbvh_tri_ray_prepare_valid(ts->ray, &ts->tprep);

@@ -55,7 +55,7 @@ static inline int plain_root(trav_state *ts, const cbvh_ref_ray *r, const float 
  * culling bound after them. */
 static inline int plain_leaf(trav_state *ts, uint32_t first, uint32_t cnt, const cbvh_cbvh_dtri *lt,
                              const uint32_t *prims, double *cull) {
-    trav_fetch(ts, ts->ids_base + (uint64_t)first * 4u, (uint64_t)cnt * 4u);
+    trav_fetch(ts, CBVH_FETCH_IDS, ts->ids_base + (uint64_t)first * 4u, (uint64_t)cnt * 4u);
     if (lt) {
         for (uint32_t i = 0; i < cnt && !ts->done; i++)
             trav_triangle_v(ts, lt[first + i].id, (const cbvh_f32(*)[3])lt[first + i].v);
