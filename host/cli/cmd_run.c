@@ -58,7 +58,7 @@ static int measure(const cbvh_scene_desc *d, const cbvh_timing_params *tp, int b
     cbvh_fx_opts o;
     memset(&o, 0, sizeof o);
     o.format = bits ? CBVH_FORMAT_CBVH : CBVH_FORMAT_FLOAT;
-    o.params.quant_bits = bits ? bits : 6;
+    o.params.quant_bits = bits ? bits : CBVH_N_DEFAULT;
     o.params.min_scale = CBVH_MIN_SCALE_DEFAULT;
     o.mant = 24;
     cbvh_fx_result r;

@@ -278,16 +278,16 @@ static void usage(FILE *f) {
                "         bunny plus proc:cloth, proc:far, proc:wave.\n"
                "  Prints the Table-1-style study (backtracking, memory traffic of LBVH and refit,\n"
                "  SAH cost, primitives per leaf) and the minimum-scale sweep of Fig. 10 (docs/study.md).\n"
-               "  --quant-bits N  coordinate bits, %d..%d (default 6); --min-scale E  %d..%d (default %d)\n"
+               "  --quant-bits N  coordinate bits, %d..%d (default %d); --min-scale E  %d..%d (default %d)\n"
                "  Exit status: 0 done, 2 bad input (an option, or a scene that cannot be loaded or built).\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_N_DEFAULT, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
 }
 
 int cmd_study(int argc, char **argv) {
     const char *defaults[] = {CBVH_SCENES_DIR "/bunny-small.obj", "proc:cloth", "proc:far", "proc:wave"};
     const char **specs = malloc((size_t)(argc + 4) * sizeof *specs);
     int ns = 0, json = 0, sweep = 1;
-    cbvh_params p = {6, CBVH_MIN_SCALE_DEFAULT};
+    cbvh_params p = {CBVH_N_DEFAULT, CBVH_MIN_SCALE_DEFAULT};
     if (!specs) cbvh_out_of_memory("scene list");
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {

@@ -37,7 +37,7 @@ static void usage(FILE *f) {
             "  where the knee is; writes a chart and heat maps (docs/sweep.md).\n"
             "  --bits LO..HI     coordinate bits N, within %d..%d (default 3..10; N alone = one value)\n"
             "  --mant M...       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
-            "  --min-scale E...  minimum grid scale, -126..126 (default %d)\n"
+            "  --min-scale E...  minimum grid scale, %d..%d (default %d)\n"
             "  --spp K           camera samples per pixel, 1..1024 (default: the scene's)\n"
             "  --out DIR         where the chart and heat maps go (default sweep-<scene name>)\n"
             "  --heatmap S...    settings to draw box tests per pixel for: float, N, N:M:E, or a traced format\n"
@@ -56,7 +56,8 @@ static void usage(FILE *f) {
             "testing:\n"
             "  --test-corrupt S:R  pretend setting S (index in trace order) returned a wrong answer for\n"
             "                      ray R, to show the identity check fails (docs/sweep.md)\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL,
+            CBVH_MIN_SCALE_DEFAULT);
 }
 
 static int is_int(const char *s) {
@@ -167,7 +168,7 @@ static int parse_heat(const char *s, heat_spec *h) {
     if (n != 1 && n != 3) return -1;
     if (strlen(s) >= sizeof buf) return -1;
     for (int i = 0; i < n; i++)
-        if (cbvh_parse_long(p[i], -126, 126, &v[i])) return -1;
+        if (cbvh_parse_long(p[i], CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &v[i])) return -1; /* wide enough for N, M and E */
     if (v[0] < CBVH_N_MIN || v[0] > CBVH_N_MAX) return -1;
     h->bits = (int)v[0];
     if (n == 3) {
@@ -354,7 +355,7 @@ int cmd_sweep(int argc, char **argv) {
                 return 2;
         } else if (strcmp(a, "--min-scale") == 0) {
             if (list_again(a, &ms_given)) return 2;
-            if ((o.nmin_scale = parse_list(a, argc, argv, &i, -126, 126, o.min_scale, CBVH_SWEEP_MAX_LIST)) < 0)
+            if ((o.nmin_scale = parse_list(a, argc, argv, &i, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, o.min_scale, CBVH_SWEEP_MAX_LIST)) < 0)
                 return 2;
         } else if (strcmp(a, "--spp") == 0) {
             long v;

@@ -22,9 +22,9 @@ static void usage(FILE *f) {
             "  rays, box/triangle tests, nodes and bytes per ray, deepest stack, modelled time per ray\n"
             "  (docs/timing_model.md) and the model's CPU time per ray; with --format cbvh (default), qbvh\n"
             "  or tlist also each relative to the float BVH on the same rays, and a units-active line.\n"
-            "  --bits N       CBVH coordinate bits, %d..%d (default 6)\n"
+            "  --bits N       CBVH coordinate bits, %d..%d (default %d)\n"
             "  --mant M       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
-            "  --min-scale E  minimum grid scale, -126..126 (default %d)\n"
+            "  --min-scale E  minimum grid scale, %d..%d (default %d)\n"
             "  --format F     float: the float BVH only; cbvh: the CBVH against the float BVH (default);\n"
             "                 qbvh: the QBVH (4-ary, compressed 32-bit stack, docs/qbvh.md) against it;\n"
             "                 tlist[:1|2|6|8][:earliest|:latest][:cull][:heads]: traversal lists over a\n"
@@ -33,7 +33,8 @@ static void usage(FILE *f) {
             "                 format; needed by tlist:...:cull\n"
             "  --spp K        camera samples per pixel, 1..1024 (default: the scene's camera.spp)\n"
             "  --json         machine-readable output\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT);
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_N_DEFAULT, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL,
+            CBVH_MIN_SCALE_DEFAULT);
 }
 
 static int parse_int(const char *opt, const char *s, long lo, long hi, int *out) {
@@ -149,7 +150,7 @@ static void print_units(const cbvh_unit_activity *u, int animated) {
 
 int cmd_trace(int argc, char **argv) {
     const char *scene = NULL;
-    int bits = 6, mant = 24, min_scale = CBVH_MIN_SCALE_DEFAULT, spp = 0, json = 0;
+    int bits = CBVH_N_DEFAULT, mant = 24, min_scale = CBVH_MIN_SCALE_DEFAULT, spp = 0, json = 0;
     cbvh_accel_format fmt = CBVH_FORMAT_CBVH;
     cbvh_tlist_opts tlo;
     char tlname[48] = "tlist", terr[200];
@@ -167,7 +168,7 @@ int cmd_trace(int argc, char **argv) {
         } else if (strcmp(a, "--mant") == 0) {
             if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, CBVH_MANT_MIN, CBVH_MANT_MAX, &mant)) return 2;
         } else if (strcmp(a, "--min-scale") == 0) {
-            if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, -126, 126, &min_scale)) return 2;
+            if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &min_scale)) return 2;
         } else if (strcmp(a, "--spp") == 0) {
             if (parse_int(a, i + 1 < argc ? argv[++i] : NULL, 1, 1024, &spp)) return 2;
         } else if (strcmp(a, "--format") == 0) {

@@ -127,7 +127,7 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, cbvh_accel_format fmt, c
     c->n = 0;
     run->same = 1;
     cbvh_fx_opts fo = {.format = fmt,
-                       .params = {run->s.bits ? run->s.bits : 6, run->s.min_scale},
+                       .params = {run->s.bits ? run->s.bits : CBVH_N_DEFAULT, run->s.min_scale},
                        .mant = run->s.mant,
                        .spp = c->o->spp,
                        .on_ray = on_ray,
@@ -188,8 +188,8 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
             return -1;
         }
     for (int i = 0; i < o->nmin_scale; i++)
-        if (o->min_scale[i] < -126 || o->min_scale[i] > 126) {
-            snprintf(err, errlen, "--min-scale %d out of range -126..126", o->min_scale[i]);
+        if (o->min_scale[i] < CBVH_SCALE_FLOOR || o->min_scale[i] > CBVH_SCALE_CEIL) {
+            snprintf(err, errlen, "--min-scale %d out of range %d..%d", o->min_scale[i], CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL);
             return -1;
         }
     int nb = o->bits_hi - o->bits_lo + 1;
