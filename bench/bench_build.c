@@ -175,7 +175,7 @@ int main(int argc, char **argv) {
     for (int i = 0; i < ns; i++) {
         cbvh_scene s;
         if (cbvh_scene_open(specs[i], &s, err, sizeof err)) die(specs[i], err);
-        cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 4, 0};
+        cbvh_compress_opts o = {{CBVH_N_DEFAULT, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 4, 0};
         double best_l = 1e30, best_bu = 1e30, best_td = 1e30, best_c = 1e30, best_run = 1e30, best_f = 1e30,
                fr[100] = {0}, best_a = 1e30;
         uint64_t slow = 0;

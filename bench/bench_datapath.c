@@ -35,7 +35,7 @@ static axis_input in[NB];
 static cbvh_node_ctx nctx[NB / 8];
 static cbvh_child_in nchild[NB / 8][2];
 static uint8_t nbytes[NB / 8][24];
-static const cbvh_params P = {6, CBVH_MIN_SCALE_DEFAULT};
+static const cbvh_params P = {CBVH_N_DEFAULT, CBVH_MIN_SCALE_DEFAULT};
 
 static uint64_t rng_state;
 static uint64_t rng(void) {
@@ -45,16 +45,6 @@ static uint64_t rng(void) {
     return z ^ (z >> 31);
 }
 static double unit(void) { return (double)(rng() >> 11) * 0x1p-53; }
-static float b2f(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, 4);
-    return f;
-}
-static cbvh_f32 f2b(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, 4);
-    return b;
-}
 
 static void make_inputs(void) {
     for (int i = 0; i < NB; i++) {
@@ -65,9 +55,9 @@ static void make_inputs(void) {
         float lb = centre - (float)unit() * size, ub = lb + size;
         float grow = (float)ldexp(1.0, (int)(rng() % 6)); /* parent 1x..32x the child */
         float plb = lb - (float)unit() * size * grow - 1e-3f, pub = ub + (float)unit() * size * grow + 1e-3f;
-        x->lb = f2b(lb);
-        x->ub = f2b(ub);
-        if (cbvh_axis_root_ctx(&P, f2b(plb), f2b(pub), &x->ctx)) abort();
+        x->lb = cbvh_f32_of(lb);
+        x->ub = cbvh_f32_of(ub);
+        if (cbvh_axis_root_ctx(&P, cbvh_f32_of(plb), cbvh_f32_of(pub), &x->ctx)) abort();
         cbvh_axis_code c;
         if (cbvh_axis_compress(&P, x->lb, x->ub, x->ctx.scale, &c)) abort();
         for (int enc = 0; enc < 2; enc++)
@@ -85,9 +75,9 @@ static void make_inputs(void) {
         }
         /* one context per pair: the union of the two children grown a bit */
         for (int a = 0; a < 3; a++) {
-            float lo = fminf(b2f(nchild[i][0].lo[a]), b2f(nchild[i][1].lo[a])) - 0.01f;
-            float hi = fmaxf(b2f(nchild[i][0].hi[a]), b2f(nchild[i][1].hi[a])) + 0.01f;
-            if (cbvh_axis_root_ctx(&P, f2b(lo), f2b(hi), &nctx[i].axis[a])) abort();
+            float lo = fminf(cbvh_float_of(nchild[i][0].lo[a]), cbvh_float_of(nchild[i][1].lo[a])) - 0.01f;
+            float hi = fmaxf(cbvh_float_of(nchild[i][0].hi[a]), cbvh_float_of(nchild[i][1].hi[a])) + 0.01f;
+            if (cbvh_axis_root_ctx(&P, cbvh_f32_of(lo), cbvh_f32_of(hi), &nctx[i].axis[a])) abort();
         }
         cbvh_child_out out[2];
         if (cbvh_nodepair_encode(&P, CBVH_ENC_MODULO, &nctx[i], nchild[i], nbytes[i], out)) abort();
@@ -113,16 +103,16 @@ static void make_sphere_inputs(void) {
             for (int a = 0; a < 3; a++) {
                 c[a] = (float)(unit() * 128.0 - 64.0);
                 o[a] = (float)(unit() * 128.0 - 64.0);
-                x->c[a] = f2b(c[a]);
-                x->ray.o[a] = f2b(o[a]);
+                x->c[a] = cbvh_f32_of(c[a]);
+                x->ray.o[a] = cbvh_f32_of(o[a]);
             }
             for (int a = 0; a < 3; a++) {
                 float d = aim ? c[a] - o[a] + (float)((unit() - 0.5) * r) : (float)(unit() * 2.0 - 1.0);
-                x->ray.d[a] = f2b(d);
+                x->ray.d[a] = cbvh_f32_of(d);
             }
-            x->r = f2b(r);
+            x->r = cbvh_f32_of(r);
             x->ray.tmin = 0;
-            x->ray.tmax = rng() % 2 ? CBVH_F32_POS_INF : f2b((float)(unit() * 4.0));
+            x->ray.tmax = rng() % 2 ? CBVH_F32_POS_INF : cbvh_f32_of((float)(unit() * 4.0));
         }
 }
 
@@ -130,14 +120,14 @@ static void make_sphere_inputs(void) {
 static int naive_sphere(const sphere_input *x) {
     float o[3], d[3], w[3], A = 0, B = 0, C = 0;
     for (int a = 0; a < 3; a++) {
-        o[a] = b2f(x->ray.o[a]);
-        d[a] = b2f(x->ray.d[a]);
-        w[a] = b2f(x->c[a]) - o[a];
+        o[a] = cbvh_float_of(x->ray.o[a]);
+        d[a] = cbvh_float_of(x->ray.d[a]);
+        w[a] = cbvh_float_of(x->c[a]) - o[a];
         A += d[a] * d[a];
         B += w[a] * d[a];
         C += w[a] * w[a];
     }
-    float r = b2f(x->r), tmax = b2f(x->ray.tmax);
+    float r = cbvh_float_of(x->r), tmax = cbvh_float_of(x->ray.tmax);
     float t = B / A;
     t = t < 0 ? 0 : t > tmax ? tmax : t;
     return A * t * t - 2 * B * t + C <= r * r;
@@ -163,7 +153,7 @@ static void naive_compress_ldexpf(int n, int min_scale, float lb, float ub, int 
 }
 
 /* 2^x as a float built from its bits (|x| <= 126) */
-static float pow2f(int x) { return b2f((cbvh_f32)(x + 127) << 23); }
+static float pow2f(int x) { return cbvh_float_of(cbvh_f32_make(0, x, 0)); }
 
 static void naive_compress_mul(int n, int min_scale, float lb, float ub, int e, naive_code *o) {
     float inv = pow2f(-e), step = pow2f(e);
@@ -185,7 +175,7 @@ static void naive_decode(int n, int min_scale, const cbvh_axis_ctx *ctx, uint32_
     uint32_t pmod = sh >= n ? 0 : (ctx->lb_mod << sh) & mask;
     uint32_t r = (lc - pmod) & mask, s = (uc - pmod) & mask;
     if (s == 0) s = mask + 1u;
-    float step = pow2f(ctx->scale), u = b2f(ctx->clb);
+    float step = pow2f(ctx->scale), u = cbvh_float_of(ctx->clb);
     o->lb_mod = lc;
     o->ub_mod = uc;
     int cs = ctx->scale - n + (s - r > 1 ? 32 - __builtin_clz(s - r - 1u) : 0);
@@ -264,13 +254,13 @@ int main(int argc, char **argv) {
     });
     TIME_LOOP(t_nl, 1, NB, {
         naive_code c;
-        naive_compress_ldexpf(P.quant_bits, P.min_scale, b2f(in[i].lb), b2f(in[i].ub), in[i].ctx.scale, &c);
-        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ f2b(c.clb) ^ f2b(c.cub);
+        naive_compress_ldexpf(P.quant_bits, P.min_scale, cbvh_float_of(in[i].lb), cbvh_float_of(in[i].ub), in[i].ctx.scale, &c);
+        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ cbvh_f32_of(c.clb) ^ cbvh_f32_of(c.cub);
     });
     TIME_LOOP(t_nm, 1, NB, {
         naive_code c;
-        naive_compress_mul(P.quant_bits, P.min_scale, b2f(in[i].lb), b2f(in[i].ub), in[i].ctx.scale, &c);
-        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ f2b(c.clb) ^ f2b(c.cub);
+        naive_compress_mul(P.quant_bits, P.min_scale, cbvh_float_of(in[i].lb), cbvh_float_of(in[i].ub), in[i].ctx.scale, &c);
+        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ cbvh_f32_of(c.clb) ^ cbvh_f32_of(c.cub);
     });
     TIME_LOOP(t_dmod, 1, NB, {
         cbvh_axis_code c;
@@ -285,7 +275,7 @@ int main(int argc, char **argv) {
     TIME_LOOP(t_nd, 1, NB, {
         naive_code c;
         naive_decode(P.quant_bits, P.min_scale, &in[i].ctx, in[i].lc[0], in[i].uc[0], &c);
-        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ f2b(c.clb) ^ f2b(c.cub);
+        acc += c.lb_mod ^ c.ub_mod ^ (uint32_t)c.child_scale ^ cbvh_f32_of(c.clb) ^ cbvh_f32_of(c.cub);
     });
     TIME_LOOP(t_est, 1, NB, {
         int e;

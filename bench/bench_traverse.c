@@ -134,7 +134,7 @@ int main(int argc, char **argv) {
         cbvh_scene s;
         cbvh_bvh b;
         load_scene(specs[si], &s, &b, "build");
-        cbvh_compress_opts o = {{6, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 1, 0};
+        cbvh_compress_opts o = {{CBVH_N_DEFAULT, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 1, 0};
         cbvh_tree t;
         if (cbvh_compress_topdown(&b, &o, &t, err, sizeof err)) die("compress", err);
         cbvh_fbvh fb;

@@ -37,21 +37,10 @@ static uint32_t get32(reader *r) {
     return v;
 }
 
-static float bits_float(uint32_t b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-
 /* A coordinate: on a 1/16 grid in [-8, 8), or (raw) any binary32. */
-static float coord(reader *r, int raw) { return raw ? bits_float(get32(r)) : (float)((int)get8(r) - 128) / 16.0f; }
+static float coord(reader *r, int raw) { return raw ? cbvh_float_of(get32(r)) : (float)((int)get8(r) - 128) / 16.0f; }
 
-static cbvh_f32 coord_bits(reader *r, int raw) {
-    float f = coord(r, raw);
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
+static cbvh_f32 coord_bits(reader *r, int raw) { return cbvh_f32_of(coord(r, raw)); }
 
 /* The closest hit by brute force: the smallest (t, index) the unit hits in
  * [tmin, tmax] (docs/traversal.md §5). */

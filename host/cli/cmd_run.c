@@ -97,7 +97,7 @@ static int measure(const cbvh_scene_desc *d, const run_machine *rm, int bits, wi
             return -1;
         }
     cbvh_config_model cm;
-    if (cbvh_config_model_init(&cm, &r, &rm->table, &rm->tp, "ray_box", bits ? bits : 6, 24, err, errlen)) return -1;
+    if (cbvh_config_model_init(&cm, &r, &rm->table, &rm->tp, "ray_box", bits ? bits : CBVH_N_DEFAULT, 24, err, errlen)) return -1;
     memset(row, 0, sizeof *row);
     row->bits = bits;
     row->tot = cbvh_fx_total(&r);

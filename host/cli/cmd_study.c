@@ -365,11 +365,11 @@ static void usage(FILE *f) {
                "         bunny plus proc:cloth, proc:far, proc:wave.\n"
                "  Prints the Table-1-style study (backtracking, memory traffic of LBVH and refit,\n"
                "  SAH cost, primitives per leaf) and the minimum-scale sweep of Fig. 10 (docs/study.md).\n"
-               "  --quant-bits N  coordinate bits, %d..%d (default 6); --min-scale E  %d..%d (default %d)\n"
+               "  --quant-bits N  coordinate bits, %d..%d (default %d); --min-scale E  %d..%d (default %d)\n"
                "  --timing K=V,...  the DRAM of the build and refit times (docs/timing_model.md §7):\n"
                "                  dram_bytes_per_cycle, fetch_latency, clock_mhz (default 12.8, 100, 1000)\n"
                "  Exit status: 0 done, 2 bad input (an option, or a scene that cannot be loaded or built).\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_N_DEFAULT, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, CBVH_MIN_SCALE_DEFAULT);
 }
 
 typedef struct {
@@ -485,7 +485,7 @@ int cmd_study(int argc, char **argv) {
     snprintf(bunny, sizeof bunny, "%s/scenes/bunny-small.obj", cbvh_data_dir());
     const char *defaults[] = {bunny, "proc:cloth", "proc:far", "proc:wave"};
     study_opts o = {.specs = malloc((size_t)(argc + 4) * sizeof *o.specs), .sweep = 1,
-                    .p = {6, CBVH_MIN_SCALE_DEFAULT}};
+                    .p = {CBVH_N_DEFAULT, CBVH_MIN_SCALE_DEFAULT}};
     cbvh_timing_defaults(&o.tp);
     if (!o.specs) cbvh_out_of_memory("scene list");
     int rc = parse_options(argc, argv, &o);

@@ -43,7 +43,7 @@ static void usage(FILE *f) {
             "  where the knee is; writes a chart and heat maps (docs/sweep.md).\n"
             "  --bits LO..HI     coordinate bits N, within %d..%d (default 3..10; N alone = one value)\n"
             "  --mant M...       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
-            "  --min-scale E...  minimum grid scale, -126..126 (default %d)\n"
+            "  --min-scale E...  minimum grid scale, %d..%d (default %d)\n"
             "  --spp K           camera samples per pixel, 1..1024 (default: the scene's)\n"
             "  --out DIR         where the chart and heat maps go (default sweep-<scene name>)\n"
             "  --heatmap S...    settings to draw box tests per pixel for: float, N, N:M:E, or a traced format\n"
@@ -70,7 +70,8 @@ static void usage(FILE *f) {
             "testing:\n"
             "  --test-corrupt S:R  pretend setting S (index in trace order) returned a wrong answer for\n"
             "                      ray R, to show the identity check fails (docs/sweep.md)\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_MIN_SCALE_DEFAULT, CBVH_CACHES_MAX,
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL,
+            CBVH_MIN_SCALE_DEFAULT, CBVH_CACHES_MAX,
             CBVH_REPS_MAX);
 }
 
@@ -177,7 +178,7 @@ static int parse_heat(const char *s, heat_spec *h) {
     if (n != 1 && n != 3) return -1;
     if (strlen(s) >= sizeof buf) return -1;
     for (int i = 0; i < n; i++)
-        if (cbvh_parse_long(p[i], -126, 126, &v[i])) return -1;
+        if (cbvh_parse_long(p[i], CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, &v[i])) return -1; /* wide enough for N, M and E */
     if (v[0] < CBVH_N_MIN || v[0] > CBVH_N_MAX) return -1;
     h->bits = (int)v[0];
     if (n == 3) {
@@ -571,7 +572,7 @@ static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli
         return o->nmant < 0 ? -1 : 0;
     case OPT_MIN_SCALE:
         if (list_again("--min-scale", &c->ms_given)) return -1;
-        o->nmin_scale = parse_list("--min-scale", v, argc, argv, -126, 126, o->min_scale, CBVH_SWEEP_MAX_LIST);
+        o->nmin_scale = parse_list("--min-scale", v, argc, argv, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL, o->min_scale, CBVH_SWEEP_MAX_LIST);
         return o->nmin_scale < 0 ? -1 : 0;
     case OPT_SPP:
         if (cbvh_parse_long(v, 1, 1024, &n)) {
@@ -788,7 +789,7 @@ static int model_figures(const sweep_cli *c, const cbvh_scene_desc *d, sweep_fig
     for (int k = 0; k < f->ncfg && !rc; k++) {
         const cbvh_sweep_run_t *r = cfg_run(res, k);
         rc = cbvh_config_model_init(&f->cm[k], &r->r, &f->table, &f->tp, cbvh_box_units[r->s.box_unit].cost_unit,
-                                    r->s.bits ? r->s.bits : 6, r->s.mant, err, errlen);
+                                    r->s.bits ? r->s.bits : CBVH_N_DEFAULT, r->s.mant, err, errlen);
         cbvh_fx_stats t = cbvh_fx_total(&r->r);
         for (int ci = 0; ci < f->ncaches && !rc; ci++) {
             cbvh_ray_metrics *m = &f->tot[(size_t)k * f->ncaches + ci];

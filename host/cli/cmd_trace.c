@@ -38,10 +38,10 @@ static void usage(FILE *f) {
             "  per ray and the cache's hit rate (docs/timing_model.md) and the model's CPU time per ray;\n"
             "  with any format but float\n"
             "  also each relative to the float BVH on the same rays, and a units-active line.\n"
-            "  --bits N       CBVH coordinate bits, %d..%d (default 6)\n"
+            "  --bits N       CBVH coordinate bits, %d..%d (default %d)\n"
             "  --mant M       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
             "  --min-scale E  minimum grid scale, %d..%d (default %d)\n",
-            CBVH_N_MIN, CBVH_N_MAX, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL,
+            CBVH_N_MIN, CBVH_N_MAX, CBVH_N_DEFAULT, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL,
             CBVH_MIN_SCALE_DEFAULT);
     /* One line (or more) per format: its help, continued lines indented. */
     for (size_t i = 0; i < n; i++) {
@@ -262,7 +262,7 @@ static int parse_options(int argc, char **argv, trace_opts *t) {
                                              {"json", no_argument, 0, 'j'},
                                              {"help", no_argument, 0, 'h'},
                                              {0, 0, 0, 0}};
-    *t = (trace_opts){.bits = 6,
+    *t = (trace_opts){.bits = CBVH_N_DEFAULT,
                       .mant = 24,
                       .min_scale = CBVH_MIN_SCALE_DEFAULT,
                       .reps = 5,

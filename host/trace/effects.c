@@ -45,16 +45,6 @@ static void norm3(float v[3]) {
     if (l > 0)
         for (int i = 0; i < 3; i++) v[i] /= l;
 }
-static cbvh_f32 fbits(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float bitsf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
 /* Orthonormal basis (t, b) around unit n. */
 static void onb(const float n[3], float t[3], float b[3]) {
     float a[3] = {fabsf(n[0]) > 0.9f ? 0.0f : 1.0f, fabsf(n[0]) > 0.9f ? 1.0f : 0.0f, 0.0f};
@@ -119,11 +109,11 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
                  uint32_t src, int light, cbvh_trav_hit *hit) {
     cbvh_ray r;
     for (int a = 0; a < 3; a++) {
-        r.o[a] = fbits(o[a]);
-        r.d[a] = fbits(dir[a]);
+        r.o[a] = cbvh_f32_of(o[a]);
+        r.d[a] = cbvh_f32_of(dir[a]);
     }
     r.tmin = 0;
-    r.tmax = isinf(tmax) ? CBVH_F32_POS_INF : fbits(tmax);
+    r.tmax = isinf(tmax) ? CBVH_F32_POS_INF : cbvh_f32_of(tmax);
     cbvh_trav_stats st = {0};
     /* One-sided scenes: the same rule on every format (the reference included). */
     cbvh_trav_mode tm = T->o->one_sided ? (cbvh_trav_mode)(mode | CBVH_TRAV_FRONT_ONLY) : mode;
@@ -149,7 +139,7 @@ static int trace(tracer *T, cbvh_effect fx, cbvh_trav_mode mode, const float o[3
 /* Hit point and the geometric normal facing the incoming ray. */
 static void surface(const tracer *T, const float o[3], const float dir[3], const cbvh_trav_hit *h, float p[3],
                     float n[3]) {
-    float t = bitsf(h->t);
+    float t = cbvh_float_of(h->t);
     for (int a = 0; a < 3; a++) p[a] = o[a] + t * dir[a];
     const cbvh_tri *tr = &T->tris[h->prim];
     float e1[3], e2[3];

@@ -131,7 +131,7 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char
     c->n = 0;
     run->same = 1;
     cbvh_fx_opts fo = {.format = format,
-                       .params = {run->s.bits ? run->s.bits : 6, run->s.min_scale},
+                       .params = {run->s.bits ? run->s.bits : CBVH_N_DEFAULT, run->s.min_scale},
                        .mant = run->s.mant,
                        .spp = c->o->spp,
                        .on_ray = on_ray,
@@ -165,7 +165,7 @@ static int timed_reps(sweep_ctx *c, cbvh_sweep_result *res, char *err, size_t er
             c->rep = k;
             c->label = fmt;
             cbvh_fx_opts fo = {.format = fmt,
-                               .params = {run->s.bits ? run->s.bits : 6, run->s.min_scale},
+                               .params = {run->s.bits ? run->s.bits : CBVH_N_DEFAULT, run->s.min_scale},
                                .mant = run->s.mant,
                                .spp = o->spp,
                                .progress = on_progress,
@@ -225,8 +225,9 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
             return -1;
         }
     for (int i = 0; i < o->nmin_scale; i++)
-        if (o->min_scale[i] < -126 || o->min_scale[i] > 126) {
-            snprintf(err, errlen, "--min-scale %d out of range -126..126", o->min_scale[i]);
+        if (o->min_scale[i] < CBVH_SCALE_FLOOR || o->min_scale[i] > CBVH_SCALE_CEIL) {
+            snprintf(err, errlen, "--min-scale %d out of range %d..%d", o->min_scale[i], CBVH_SCALE_FLOOR,
+                     CBVH_SCALE_CEIL);
             return -1;
         }
     int nb = o->bits_hi - o->bits_lo + 1;

@@ -103,10 +103,10 @@ size_t cbvh_vecgen_specs(const cbvh_vecgen_select *sel, cbvh_vecgen_spec *out, s
             const vg_unit *ug = find_gen(unit);
             if (!ug || (sel->unit && sel->unit != unit)) continue;
             if (pass == 1 && !ug->extra_min_scales) continue;
-            static const int extra_ms[] = {-126, -10};
+            static const int extra_ms[] = {CBVH_SCALE_FLOOR, -10};
             int nlo = sel->bits ? sel->bits : CBVH_N_MIN, nhi = sel->bits ? sel->bits : CBVH_N_MAX;
-            if (pass == 1) nlo = nhi = 6;
-            if (!ug->per_n && !sel->bits) nlo = nhi = 6;
+            if (pass == 1) nlo = nhi = CBVH_N_DEFAULT;
+            if (!ug->per_n && !sel->bits) nlo = nhi = CBVH_N_DEFAULT;
             for (int bits = nlo; bits <= nhi; bits++)
                 for (int m = 0; m < (pass == 1 ? 2 : 1); m++)
                     for (int e = 0; e < (unit->uses_encoding ? 2 : 1); e++) {

@@ -16,12 +16,6 @@ static inline uint64_t cbvh_gen_next(uint64_t *s) {
     return *s;
 }
 
-static inline uint32_t cbvh_gen_float_bits(float f) {
-    uint32_t w;
-    memcpy(&w, &f, 4);
-    return w;
-}
-
 static inline void cbvh_gen_inputs(uint64_t *rng, const cbvh_unit_config *cfg, const cbvh_layout *lay, uint32_t *in,
                                    size_t count) {
     for (size_t v = 0; v < count; v++)
@@ -30,7 +24,7 @@ static inline void cbvh_gen_inputs(uint64_t *rng, const cbvh_unit_config *cfg, c
             uint32_t w;
             int digits = lay->in[f].hex_digits;
             if ((r & 15) == 0) w = (uint32_t)(r >> 32); /* raw bits, any field */
-            else if (digits == 8) w = cbvh_gen_float_bits((float)((int64_t)(r >> 40) - (1 << 23)) / (float)(1u << (r % 20)));
+            else if (digits == 8) w = cbvh_f32_of((float)((int64_t)(r >> 40) - (1 << 23)) / (float)(1u << (r % 20)));
             else if (digits == 2) w = cbvh_scale_to_word((int)((r >> 8) % 80) - 40);
             else if (digits == 3) w = (uint32_t)(r >> 8) & ((1u << cfg->params.quant_bits) - 1u);
             else w = (uint32_t)(r >> 8) & ((1u << (4 * digits)) - 1u);

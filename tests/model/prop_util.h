@@ -33,8 +33,7 @@ static inline uint32_t prng_below(prng *r, uint32_t n) { return (uint32_t)((prng
 static inline int prng_range(prng *r, int lo, int hi) { return lo + (int)prng_below(r, (uint32_t)(hi - lo + 1)); }
 
 /* ---- bit patterns (fb, bf: tests/common/test_util.h) ---- */
-/* monotone integer key of a finite pattern (both zeros -> 0) and back (0 -> +0) */
-static inline int64_t fkey(cbvh_f32 b) { return (b & CBVH_F32_SIGN) ? -(int64_t)(b & ~CBVH_F32_SIGN) : (int64_t)b; }
+/* back from cbvh_f32_key, the monotone integer key (0 -> +0) */
 static inline cbvh_f32 unkey(int64_t k) { return k < 0 ? (CBVH_F32_SIGN | (cbvh_f32)(-k)) : (cbvh_f32)k; }
 
 /* A float pattern from the structured table or random, finite. */
@@ -49,7 +48,7 @@ static const uint32_t prop_sig_patterns[] = {0x000000, 0x000001, 0x000002, 0x7FF
 
 static inline cbvh_f32 prop_structured(int i) {
     int s = i % 2, j = i / 2;
-    return ((cbvh_f32)s << 31) | (prop_exp_patterns[j % PROP_N_EXP] << 23) | prop_sig_patterns[j / PROP_N_EXP];
+    return ((cbvh_f32)s << 31) | (prop_exp_patterns[j % PROP_N_EXP] << CBVH_F32_FRAC_BITS) | prop_sig_patterns[j / PROP_N_EXP];
 }
 
 /* Random finite float with a wide spread of magnitudes. */
@@ -61,12 +60,12 @@ static inline cbvh_f32 prop_random_float(prng *r) {
         while ((b & CBVH_F32_EXP) == CBVH_F32_EXP);
         return b;
     case 1: /* scene-like magnitudes 2^-20..2^20 */
-        return ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32)prng_range(r, 107, 147) << 23) |
+        return ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32)prng_range(r, 107, 147) << CBVH_F32_FRAC_BITS) |
                ((cbvh_f32)prng_next(r) & CBVH_F32_FRAC);
     case 2: /* structured */
         return prop_structured((int)prng_below(r, PROP_N_STRUCT));
     default: /* a structured exponent with a random significand */
-        return ((cbvh_f32)prng_below(r, 2) << 31) | (prop_exp_patterns[prng_below(r, PROP_N_EXP)] << 23) |
+        return ((cbvh_f32)prng_below(r, 2) << 31) | (prop_exp_patterns[prng_below(r, PROP_N_EXP)] << CBVH_F32_FRAC_BITS) |
                ((cbvh_f32)prng_next(r) & CBVH_F32_FRAC);
     }
 }
@@ -74,7 +73,7 @@ static inline cbvh_f32 prop_random_float(prng *r) {
 /* A point in [lo, hi] (finite, lo <= hi): the ends, their neighbours, uniform
  * in the key space (log-like) or linear (double arithmetic, deterministic). */
 static inline cbvh_f32 prop_point_in(prng *r, cbvh_f32 lo, cbvh_f32 hi) {
-    int64_t a = fkey(lo), b = fkey(hi);
+    int64_t a = cbvh_f32_key(lo), b = cbvh_f32_key(hi);
     switch (prng_below(r, 8)) {
     case 0: return lo;
     case 1: return hi;
@@ -87,8 +86,8 @@ static inline cbvh_f32 prop_point_in(prng *r, cbvh_f32 lo, cbvh_f32 hi) {
         double v = (double)bf(lo) + t * ((double)bf(hi) - (double)bf(lo));
         float f = (float)v; /* round to nearest, then clamp into [lo, hi] */
         cbvh_f32 x = fb(f);
-        if ((x & CBVH_F32_EXP) == CBVH_F32_EXP || fkey(x) < a) x = lo;
-        if (fkey(x) > b) x = hi;
+        if ((x & CBVH_F32_EXP) == CBVH_F32_EXP || cbvh_f32_key(x) < a) x = lo;
+        if (cbvh_f32_key(x) > b) x = hi;
         return x;
     }
     }

@@ -83,7 +83,7 @@ static void random_box(prng *r, cbvh_f32 *lb, cbvh_f32 *ub) {
         break;
     case 1: { /* narrow: a few ulps to 2^20 ulps apart */
         a = prop_random_float(r);
-        int64_t k = fkey(a) + (int64_t)(prng_next(r) % (UINT64_C(1) << prng_range(r, 0, 20)));
+        int64_t k = cbvh_f32_key(a) + (int64_t)(prng_next(r) % (UINT64_C(1) << prng_range(r, 0, 20)));
         if (k > (int64_t)CBVH_F32_MAX) k = CBVH_F32_MAX;
         b = unkey(k);
         break;
@@ -103,14 +103,14 @@ static void random_box(prng *r, cbvh_f32 *lb, cbvh_f32 *ub) {
         b = prop_random_float(r);
         break;
     default: /* the same binade or neighbouring ones, scene-like */
-        a = ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32)prng_range(r, 100, 160) << 23) |
+        a = ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32)prng_range(r, 100, 160) << CBVH_F32_FRAC_BITS) |
             ((cbvh_f32)prng_next(r) & CBVH_F32_FRAC);
-        b = (a & CBVH_F32_SIGN) | ((((a >> 23) & 0xFFu) + (cbvh_f32)prng_below(r, 3)) << 23) |
+        b = (a & CBVH_F32_SIGN) | ((cbvh_f32_exp_field(a) + (cbvh_f32)prng_below(r, 3)) << CBVH_F32_FRAC_BITS) |
             ((cbvh_f32)prng_next(r) & CBVH_F32_FRAC);
         if (prng_below(r, 2)) b ^= CBVH_F32_SIGN;
         break;
     }
-    if (fkey(a) > fkey(b)) {
+    if (cbvh_f32_key(a) > cbvh_f32_key(b)) {
         cbvh_f32 t = a;
         a = b;
         b = t;

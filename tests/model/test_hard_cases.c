@@ -72,7 +72,7 @@ static void chain_checked(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, prng *
     cbvh_axis_ctx ctx = root_checked(p, lb, ub);
     for (int d = 0; d < depth; d++) {
         cbvh_f32 a = prop_point_in(r, lb, ub), b = prop_point_in(r, lb, ub);
-        if (fkey(a) > fkey(b)) { cbvh_f32 t = a; a = b; b = t; }
+        if (cbvh_f32_key(a) > cbvh_f32_key(b)) { cbvh_f32 t = a; a = b; b = t; }
         cbvh_axis_code c;
         child_checked(p, &ctx, a, b, &c);
         ctx = cbvh_axis_child_ctx(&ctx, &c);
@@ -90,7 +90,7 @@ static void chains_all_params(cbvh_f32 lb, cbvh_f32 ub, prng *r) {
         }
 }
 
-static cbvh_f32 ulps(cbvh_f32 x, int k) { return unkey(fkey(x) + k); }
+static cbvh_f32 ulps(cbvh_f32 x, int k) { return unkey(cbvh_f32_key(x) + k); }
 
 /* ---- cloth: a finely tessellated plane at z = -0.4 ---------------------- */
 #define CLOTH_G 64 /* 64 x 64 quads, 8192 triangles */
@@ -254,13 +254,13 @@ static int case_far_from_origin(void) {
             cbvh_f32 c = fb(s ? -centres[i] : centres[i]);
             for (int w = 0; w <= 5; w++) {
                 cbvh_f32 lb = c, ub = ulps(c, w * w); /* 0, 1, 4, ... 25 ulps */
-                if (fkey(lb) > fkey(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
+                if (cbvh_f32_key(lb) > cbvh_f32_key(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
                 chains_all_params(lb, ub, &r);
                 /* tiny boxes must decode tight: within a few ulps of the box */
                 cbvh_axis_ctx ctx = root_checked(&P6_126, lb, ub);
                 cbvh_axis_code code;
                 compress_checked(&P6_126, lb, ub, ctx.parent_scale, &code);
-                CHECK(fkey(code.clb) >= fkey(lb) - 64 && fkey(code.cub) <= fkey(ub) + 64,
+                CHECK(cbvh_f32_key(code.clb) >= cbvh_f32_key(lb) - 64 && cbvh_f32_key(code.cub) <= cbvh_f32_key(ub) + 64,
                       "far: [%08x,%08x] decoded loosely to [%08x,%08x]", lb, ub, code.clb, code.cub);
             }
         }
@@ -341,7 +341,7 @@ static int case_subnormals(void) {
         for (int j = 0; j < ns; j++)
             for (int s = 0; s < 3; s++) {
                 cbvh_f32 lb = sub[i] | (s >= 1 ? CBVH_F32_SIGN : 0), ub = sub[j] | (s == 2 ? CBVH_F32_SIGN : 0);
-                if (fkey(lb) > fkey(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
+                if (cbvh_f32_key(lb) > cbvh_f32_key(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
                 chains_all_params(lb, ub, &r);
                 for (int e = CBVH_SCALE_FLOOR; e <= -100; e++) {
                     cbvh_axis_code c;
@@ -365,7 +365,7 @@ static int case_largest_finite(void) {
     const cbvh_f32 ubs[] = {M, ulps(M, -1), fb(0x1p127f), fb(1.0f), fb(-0x1p127f), NM};
     for (size_t i = 0; i < sizeof lbs / sizeof lbs[0]; i++)
         for (size_t j = 0; j < sizeof ubs / sizeof ubs[0]; j++) {
-            if (fkey(lbs[i]) > fkey(ubs[j])) continue;
+            if (cbvh_f32_key(lbs[i]) > cbvh_f32_key(ubs[j])) continue;
             chains_all_params(lbs[i], ubs[j], &r);
         }
     /* the 2^128 grid point: RU -> +Inf, RD -> -Inf; contexts carry -Inf as -2^128 */
@@ -407,7 +407,7 @@ static int case_min_scale_saturation(void) {
             const cbvh_f32 lbs[] = {fb(1.0f), fb(-0.4f), fb(1e-30f), fb(3e7f), 0x00000010u};
             for (size_t i = 0; i < sizeof lbs / sizeof lbs[0]; i++) {
                 cbvh_f32 lb = lbs[i], ub = ulps(lbs[i], 3);
-                if (fkey(lb) > fkey(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
+                if (cbvh_f32_key(lb) > cbvh_f32_key(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
                 int est;
                 cbvh_scale_estimate(&p, lb, ub, &est);
                 cbvh_axis_ctx ctx = root_checked(&p, lb, ub);
@@ -422,7 +422,7 @@ static int case_min_scale_saturation(void) {
                           ctx.parent_scale, ctx.scale, p.min_scale);
                 for (int d = 0; d < 6; d++) {
                     cbvh_f32 a = prop_point_in(&r, lb, ub), b = prop_point_in(&r, lb, ub);
-                    if (fkey(a) > fkey(b)) { cbvh_f32 t = a; a = b; b = t; }
+                    if (cbvh_f32_key(a) > cbvh_f32_key(b)) { cbvh_f32 t = a; a = b; b = t; }
                     cbvh_axis_code c;
                     child_checked(&p, &ctx, a, b, &c);
                     CHECK(c.child_scale >= p.min_scale && c.child_scale <= ctx.scale,
@@ -458,7 +458,7 @@ static int case_every_n(void) {
         CHECK(pb == (w - 6 * n - 1 > 32 ? 32 : w - 6 * n - 1) && pb >= 27, "N=%d: pointer bits %d", n, pb);
         for (int i = 0; i < 2000; i++) {
             cbvh_f32 lb = prop_random_float(&r), ub = prop_random_float(&r);
-            if (fkey(lb) > fkey(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
+            if (cbvh_f32_key(lb) > cbvh_f32_key(ub)) { cbvh_f32 t = lb; lb = ub; ub = t; }
             cbvh_params p = {n, i & 1 ? CBVH_SCALE_FLOOR : CBVH_MIN_SCALE_DEFAULT};
             chain_checked(&p, lb, ub, &r, 6);
             /* N bits fit the node box: at the root's own scale the box spans <= 2^N cells */

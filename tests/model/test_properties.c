@@ -42,8 +42,8 @@ static void random_box(prng *r, long i, cbvh_f32 *lb, cbvh_f32 *ub) {
         break;
     case 3: { /* far from the origin, a few ulps wide */
         a = prop_random_float(r);
-        if (prng_below(r, 2)) a = (a & CBVH_F32_SIGN) | ((cbvh_f32)prng_range(r, 157, 254) << 23) | (a & CBVH_F32_FRAC);
-        int64_t k = fkey(a) + prng_range(r, 0, 40);
+        if (prng_below(r, 2)) a = (a & CBVH_F32_SIGN) | ((cbvh_f32)prng_range(r, 157, 254) << CBVH_F32_FRAC_BITS) | (a & CBVH_F32_FRAC);
+        int64_t k = cbvh_f32_key(a) + prng_range(r, 0, 40);
         if (k > (int64_t)CBVH_F32_MAX) k = (int64_t)CBVH_F32_MAX;
         b = unkey(k);
         break;
@@ -53,7 +53,7 @@ static void random_box(prng *r, long i, cbvh_f32 *lb, cbvh_f32 *ub) {
         b = prop_random_float(r);
         break;
     }
-    if (fkey(a) > fkey(b)) { cbvh_f32 t = a; a = b; b = t; }
+    if (cbvh_f32_key(a) > cbvh_f32_key(b)) { cbvh_f32 t = a; a = b; b = t; }
     *lb = a;
     *ub = b;
 }
@@ -186,7 +186,7 @@ static void prop_decode_chains(prng *r, long iters) {
         int depth = prng_range(r, 1, 12);
         for (int d = 0; d < depth; d++, done++) {
             cbvh_f32 a = prop_point_in(r, lb, ub), b = prop_point_in(r, lb, ub);
-            if (fkey(a) > fkey(b)) { cbvh_f32 t = a; a = b; b = t; }
+            if (cbvh_f32_key(a) > cbvh_f32_key(b)) { cbvh_f32 t = a; a = b; b = t; }
             if (prng_below(r, 16) == 0) b = a; /* zero-width child */
             cbvh_axis_code c;
             check_child(&p, &ctx, a, b, &c);
@@ -270,7 +270,7 @@ static void random_node_ctx(prng *r, const cbvh_params *p, cbvh_node_ctx *ctx, c
         int depth = prng_range(r, 0, 3); /* sometimes a deeper context */
         for (int d = 0; d < depth; d++) {
             cbvh_f32 x = prop_point_in(r, lo[a], hi[a]), y = prop_point_in(r, lo[a], hi[a]);
-            if (fkey(x) > fkey(y)) { cbvh_f32 t = x; x = y; y = t; }
+            if (cbvh_f32_key(x) > cbvh_f32_key(y)) { cbvh_f32 t = x; x = y; y = t; }
             cbvh_axis_code c;
             cbvh_axis_compress(p, x, y, ctx->axis[a].scale, &c);
             ctx->axis[a] = cbvh_axis_child_ctx(&ctx->axis[a], &c);
@@ -298,7 +298,7 @@ static void prop_nodepair_roundtrip(prng *r, long iters) {
             in[c].ptr = prng_below(r, 4) == 0 ? ptrmax : (uint32_t)prng_next(r) & ptrmax;
             for (int a = 0; a < 3; a++) {
                 cbvh_f32 x = prop_point_in(r, lo[a], hi[a]), y = prop_point_in(r, lo[a], hi[a]);
-                if (fkey(x) > fkey(y)) { cbvh_f32 t = x; x = y; y = t; }
+                if (cbvh_f32_key(x) > cbvh_f32_key(y)) { cbvh_f32 t = x; x = y; y = t; }
                 in[c].lo[a] = x;
                 in[c].hi[a] = y;
             }

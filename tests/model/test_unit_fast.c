@@ -127,19 +127,19 @@ static void random_box(prng *r, cbvh_f32 *lb, cbvh_f32 *ub) {
     switch (prng_below(r, 4)) {
     case 0: b = finite_x(random_x(r)); break;
     case 1: { /* narrow */
-        int64_t k = fkey(a) + (int64_t)(prng_next(r) % (UINT64_C(1) << prng_range(r, 0, 24)));
+        int64_t k = cbvh_f32_key(a) + (int64_t)(prng_next(r) % (UINT64_C(1) << prng_range(r, 0, 24)));
         b = unkey(k > (int64_t)CBVH_F32_MAX ? (int64_t)CBVH_F32_MAX : k);
         break;
     }
     case 2: b = a; break; /* a point (flat axis) */
     default: /* scene-like: same or neighbouring binades, either sign */
-        a = ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32)prng_range(r, 100, 160) << 23) |
+        a = ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32)prng_range(r, 100, 160) << CBVH_F32_FRAC_BITS) |
             ((cbvh_f32)prng_next(r) & CBVH_F32_FRAC);
-        b = ((cbvh_f32)prng_below(r, 2) << 31) | ((((a >> 23) & 0xFFu) + (cbvh_f32)prng_below(r, 3)) << 23) |
+        b = ((cbvh_f32)prng_below(r, 2) << 31) | ((cbvh_f32_exp_field(a) + (cbvh_f32)prng_below(r, 3)) << CBVH_F32_FRAC_BITS) |
             ((cbvh_f32)prng_next(r) & CBVH_F32_FRAC);
         break;
     }
-    if (fkey(a) > fkey(b)) {
+    if (cbvh_f32_key(a) > cbvh_f32_key(b)) {
         cbvh_f32 t = a;
         a = b;
         b = t;

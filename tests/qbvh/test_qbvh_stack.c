@@ -18,9 +18,7 @@ static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 
 /* Reference sort: insertion sort on (missed, value of t as a double, index). */
 static double fval(uint32_t b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return (double)f; /* the FPU as an independent oracle; -0 == +0 */
+    return (double)cbvh_float_of(b); /* the FPU as an independent oracle; -0 == +0 */
 }
 static void ref_sort(const uint32_t t[4], unsigned mask, int order[4], int *nhit) {
     int n = 0;

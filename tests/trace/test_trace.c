@@ -55,12 +55,6 @@ typedef struct {
     long bad;
 } watch;
 
-static float bf(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-
 static void on_ray(void *ctx, const cbvh_fx_ray *r) {
     watch *w = ctx;
     const cbvh_scene_desc *d = w->d;
@@ -79,10 +73,10 @@ static void on_ray(void *ctx, const cbvh_fx_ray *r) {
     int mirror = d->materials[d->tri_material[r->source_prim]].type == CBVH_MAT_MIRROR;
     if (mirror != (r->effect == CBVH_FX_MIRROR)) w->bad++; /* mirror rays from mirrors only, the rest from diffuse */
     float o[3], dir[3];
-    for (int a = 0; a < 3; a++) o[a] = bf(r->ray.o[a]), dir[a] = bf(r->ray.d[a]);
+    for (int a = 0; a < 3; a++) o[a] = cbvh_float_of(r->ray.o[a]), dir[a] = cbvh_float_of(r->ray.d[a]);
     if (r->effect == CBVH_FX_HARD_SHADOWS || r->effect == CBVH_FX_SOFT_SHADOWS) {
         /* Aimed at the light: o + d is on it, tmax just short of it. */
-        if (r->light < 0 || r->light >= d->nlights || !(bf(r->ray.tmax) < 1.0f && bf(r->ray.tmax) > 0.99f)) {
+        if (r->light < 0 || r->light >= d->nlights || !(cbvh_float_of(r->ray.tmax) < 1.0f && cbvh_float_of(r->ray.tmax) > 0.99f)) {
             w->bad++;
             return;
         }
@@ -102,7 +96,7 @@ static void on_ray(void *ctx, const cbvh_fx_ray *r) {
             if (fabsf(a) > 0.5001f || fabsf(b) > 0.5001f) w->bad++;
         }
     } else if (r->effect == CBVH_FX_AMBIENT_OCCLUSION) {
-        if (fabsf(bf(r->ray.tmax) - d->effect[CBVH_FX_AMBIENT_OCCLUSION].distance) > 0) w->bad++;
+        if (fabsf(cbvh_float_of(r->ray.tmax) - d->effect[CBVH_FX_AMBIENT_OCCLUSION].distance) > 0) w->bad++;
         float l = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
         if (fabsf(l - 1.0f) > 1e-3f) w->bad++;
     } else if (r->ray.tmax != CBVH_F32_POS_INF)

@@ -62,14 +62,14 @@ static cbvh_f32 rf(int emid, int spread, int wide) {
     if (e < -126) e = -126;
     if (e > 127) e = 127;
     uint32_t frac = k < 7 ? 0 : k < 10 ? below(8) << 20 : (uint32_t)(rnd() & CBVH_F32_FRAC);
-    return sign | ((uint32_t)(e + 127) << 23) | frac;
+    return sign | cbvh_f32_make(0, e, frac);
 }
 
 /* A direction component: random, power of two, few bits, sometimes zero. */
 static cbvh_f32 rdir(int wide) {
     uint32_t k = below(16);
     if (k == 0 && wide) return (rnd() & 1) ? CBVH_F32_SIGN : 0;
-    if (k < 4 && wide) return ((rnd() & 1) ? CBVH_F32_SIGN : 0) | ((uint32_t)(127 - 3 + below(7)) << 23); /* 2^k */
+    if (k < 4 && wide) return ((rnd() & 1) ? CBVH_F32_SIGN : 0) | cbvh_f32_make(0, (int)below(7) - 3, 0); /* 2^k */
     return rf(0, wide ? 60 : 3, wide);
 }
 
@@ -187,7 +187,7 @@ static void test_float_boxes(void) {
                 ray.d[a] = rf(0, 2, 0);
                 x = ray.o[a] + below(300);
                 y = x + below(300);
-                if ((x ^ ray.o[a]) >> 23 || (y ^ ray.o[a]) >> 23) x = y = ray.o[a]; /* stay in o's binade */
+                if ((x ^ ray.o[a]) >> CBVH_F32_FRAC_BITS || (y ^ ray.o[a]) >> CBVH_F32_FRAC_BITS) x = y = ray.o[a]; /* stay in o's binade */
             } else if (k == 1) {
                 x = ray.o[a]; /* origin on a plane */
                 y = rf(0, wide ? 40 : 4, 0);
@@ -265,12 +265,12 @@ static void test_grid_boxes(void) {
         for (int a = 0; a < 3; a++) {
             uint32_t k = hard ? below(7) : 6 + below(6);
             g[a].u = k == 0 ? CBVH_F32_NEG_INF : k == 1 ? (rnd() & 1) * CBVH_F32_SIGN : rf(0, wide ? 60 : 4, 0);
-            int eu = (int)((g[a].u >> 23) & 0xFF) - 127;
+            int eu = (int)cbvh_f32_exp_field(g[a].u) - CBVH_F32_EXP_BIAS;
             int e = wide ? (int)below(253) - 126 : eu - 20 + (int)below(24);
             if (k == 5) { /* sums near the binary32 range ends (subnormal / overflow) */
                 uint32_t kk = below(3);
                 g[a].u = kk == 0 ? rf(126, 1, 0) : kk == 1 ? rf(-126, 1, 0) : ((rnd() & 1) * CBVH_F32_SIGN) | below(1u << 23);
-                eu = (int)((g[a].u >> 23) & 0xFF) - 127;
+                eu = (int)cbvh_f32_exp_field(g[a].u) - CBVH_F32_EXP_BIAS;
                 e = eu - (int)below(30);
             }
             if (k == 2) e = eu - 23 - 29 + (int)below(3); /* at the exactness limits */

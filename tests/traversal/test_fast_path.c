@@ -54,7 +54,7 @@ static cbvh_f32 rf(int emid, int spread) {
     if (e < -126) e = -126;
     if (e > 127) e = 127;
     uint32_t frac = (k < 6) ? 0 : (k < 9) ? (below(8) << 20) : (uint32_t)(rnd() & CBVH_F32_FRAC); /* 2^e, few bits, any */
-    return sign | ((uint32_t)(e + 127) << 23) | frac;
+    return sign | cbvh_f32_make(0, e, frac);
 }
 
 static int small_exp(void) { return (int)below(21) - 10; }
@@ -72,8 +72,8 @@ static cbvh_ray random_ray(int emid, int spread) {
             continue;
         }
         r.d[a] = below(6) == 0 ? ((rnd() & 1) ? CBVH_F32_SIGN : 0) : rf(small_exp(), 12);
-        if (below(8) == 0) r.d[a] = (rnd() & 1 ? CBVH_F32_SIGN : 0) | ((uint32_t)(127 + small_exp()) << 23); /* 2^k */
-        if (below(10) == 0) r.d[a] = (rnd() & 1 ? CBVH_F32_SIGN : 0) | ((uint32_t)(127 + small_exp()) << 23) | 0x400000u; /* 3*2^k */
+        if (below(8) == 0) r.d[a] = (rnd() & 1 ? CBVH_F32_SIGN : 0) | cbvh_f32_make(0, small_exp(), 0); /* 2^k */
+        if (below(10) == 0) r.d[a] = (rnd() & 1 ? CBVH_F32_SIGN : 0) | cbvh_f32_make(0, small_exp(), 0x400000u); /* 3*2^k */
     }
     if (cbvh_f32_is_zero(r.d[0]) && cbvh_f32_is_zero(r.d[1]) && cbvh_f32_is_zero(r.d[2])) r.d[below(3)] = 0x3F800000u;
     r.tmin = below(4) ? 0 : rf(emid, spread);
@@ -96,7 +96,7 @@ static void box_cases(long *decided, long *total) {
         cbvh_grid_axis g[3];
         for (int a = 0; a < 3; a++) {
             g[a].u = below(64) == 0 && !typical ? CBVH_F32_NEG_INF : rf(emid, spread);
-            int eu = (int)((g[a].u >> 23) & 0xFF) - 127;
+            int eu = (int)cbvh_f32_exp_field(g[a].u) - CBVH_F32_EXP_BIAS;
             g[a].e = typical ? eu - 20 + (int)below(24) : eu - 30 + (int)below(34);
             if (below(16) == 0 && !typical) g[a].e = (int)below(253) - 126;
             if (g[a].e < CBVH_SCALE_FLOOR) g[a].e = CBVH_SCALE_FLOOR;
@@ -112,7 +112,7 @@ static void box_cases(long *decided, long *total) {
                 ray.o[a] = 0;
                 g[a].r = 3;
                 g[a].s = 3 + below(1000);
-                ray.d[a] = ((uint32_t)(127 + small_exp()) << 23) | 0x400000u | (rnd() & 1 ? CBVH_F32_SIGN : 0);
+                ray.d[a] = cbvh_f32_make(0, small_exp(), 0x400000u) | (rnd() & 1 ? CBVH_F32_SIGN : 0);
             }
         }
         if (below(32) == 0 && !typical) g[below(3)].s = g[0].r; /* sometimes an invalid box: status must match too */

@@ -32,9 +32,6 @@ static uint64_t rs = 0x9E3779B97F4A7C15u;
 static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint64_t below(uint64_t n) { return rnd() % n; }
 
-static cbvh_f32 mkf(int sign, int e, uint32_t frac) {
-    return (sign ? CBVH_F32_SIGN : 0u) | (uint32_t)(e + 127) << 23 | (frac & CBVH_F32_FRAC);
-}
 /* Structured random float: mostly moderate exponents, sometimes extreme. */
 static cbvh_f32 rfloat(void) {
     int k = (int)below(10);
@@ -44,7 +41,7 @@ static cbvh_f32 rfloat(void) {
     int e = k <= 6 ? (int)below(21) - 10 : (int)below(254) - 126;
     uint32_t frac = (uint32_t)rnd();
     if (below(3) == 0) frac &= 0xFFF000u; /* short significands: exact grid values */
-    return mkf(sign, e, frac);
+    return cbvh_f32_make(sign, e, frac);
 }
 
 /* Exact rational value of a finite pattern. */

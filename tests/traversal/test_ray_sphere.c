@@ -42,9 +42,6 @@ static uint64_t rnd(void) { return tu_xorshift64(&rs); }
 static uint64_t below(uint64_t n) { return rnd() % n; }
 static int64_t range(int64_t lo, int64_t hi) { return lo + (int64_t)below((uint64_t)(hi - lo + 1)); }
 
-static cbvh_f32 mkf(int sign, int e, uint32_t frac) {
-    return (sign ? CBVH_F32_SIGN : 0u) | (uint32_t)(e + 127) << 23 | (frac & CBVH_F32_FRAC);
-}
 /* n * 2^e exactly (|n| < 2^24, the caller keeps it in range). */
 static cbvh_f32 dy(int64_t n, int e) { return cbvh_f32_add_dyadic(n, e, 0, 0, CBVH_RND_DOWN); }
 
@@ -57,7 +54,7 @@ static cbvh_f32 rfloat(void) {
     int e = k <= 6 ? (int)below(21) - 10 : (int)below(254) - 126;
     uint32_t frac = (uint32_t)rnd();
     if (below(3) == 0) frac &= 0xFFF000u;
-    return mkf(sign, e, frac);
+    return cbvh_f32_make(sign, e, frac);
 }
 static cbvh_f32 nudge(cbvh_f32 x) { /* one ulp either way (finite) */
     if (below(2)) return x == CBVH_F32_MAX ? x : cbvh_f32_next_up(x);
@@ -255,7 +252,7 @@ static void gen_random(scase *s) {
 
 static float qd_to_f(const mpq_t q) { return (float)mpq_get_d(q); }
 /* A full-width significand at exponent e (normal range). */
-static cbvh_f32 wide(int sign, int e) { return mkf(sign, e, (uint32_t)rnd() | 1u); }
+static cbvh_f32 wide(int sign, int e) { return cbvh_f32_make(sign, e, (uint32_t)rnd() | 1u); }
 /* binary32 nearest to sqrt(q) (q >= 0, within range), then a few ulps either way. */
 static cbvh_f32 sqrt_near(const mpq_t q) {
     double v = mpq_get_d(q);

@@ -191,7 +191,8 @@ static cbvh_f32 rcoord(void) {
     int k = (int)below(8);
     if (k == 0) return below(2) ? 0 : CBVH_F32_SIGN;
     int e = k <= 5 ? (int)below(9) - 4 : (int)below(120) - 60;
-    return (below(2) ? CBVH_F32_SIGN : 0) | (uint32_t)(e + 127) << 23 | ((uint32_t)rnd() & CBVH_F32_FRAC);
+    int sign = below(2) != 0;
+    return cbvh_f32_make(sign, e, (uint32_t)rnd());
 }
 static void oracle_test(void) {
     long hits = 0;

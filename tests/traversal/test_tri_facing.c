@@ -32,14 +32,12 @@ static cbvh_f32 rnd_f32(int emin, int emax) {
     uint64_t r = rnd64();
     if ((r & 63) == 0) return (r & 64) ? CBVH_F32_SIGN : 0;
     int e = emin + (int)((r >> 8) % (uint64_t)(emax - emin + 1));
-    cbvh_f32 field = e < -126 ? 0 : (cbvh_f32)(e + 127); /* below the normal range: a subnormal */
-    return (cbvh_f32)((r >> 63) << 31) | field << 23 | (cbvh_f32)((r >> 20) & 0x7FFFFF);
+    cbvh_f32 field = e < CBVH_F32_EMIN ? 0 : (cbvh_f32)(e + CBVH_F32_EXP_BIAS); /* below the normal range: a subnormal */
+    return (cbvh_f32)((r >> 63) << 31) | field << CBVH_F32_FRAC_BITS | (cbvh_f32)((r >> 20) & CBVH_F32_FRAC);
 }
 
 static void q_of(mpq_t q, cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    mpq_set_d(q, (double)f); /* exact: every binary32 is a binary64 */
+    mpq_set_d(q, (double)cbvh_float_of(b)); /* exact: every binary32 is a binary64 */
 }
 
 static int oracle(const cbvh_f32 d[3], const cbvh_f32 v0[3], const cbvh_f32 v1[3], const cbvh_f32 v2[3]) {

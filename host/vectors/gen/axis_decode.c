@@ -50,11 +50,11 @@ static void decode_alignment_limits(gen_t *g) {
         for (int v = 0; v < 4; v++) {
             cbvh_axis_ctx c;
             c.scale = g->ms + 7 * v;
-            int eu = c.scale + d + 150; /* biased exponent of clb */
-            if (c.scale > CBVH_SCALE_CEIL || eu < 1 || eu > 254) continue;
+            int eu = c.scale + d + CBVH_F32_ULP_BIAS; /* biased exponent of clb */
+            if (c.scale > CBVH_SCALE_CEIL || cbvh_f32_field_not_normal((uint32_t)eu)) continue;
             c.parent_scale = c.scale + v % 3 > CBVH_SCALE_CEIL ? c.scale : c.scale + v % 3;
             c.lb_mod = (uint32_t)v & g->mask;
-            c.clb = ((v & 2) ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << 23 | fracs[v];
+            c.clb = ((v & 2) ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << CBVH_F32_FRAC_BITS | fracs[v];
             int shift = c.parent_scale - c.scale;
             uint32_t pmod = shift >= g->N ? 0 : (c.lb_mod << shift) & g->mask;
             uint32_t r = (uint32_t)v % 3u, sc = g->mask + 1u - (uint32_t)(v % 2); /* r < s <= 2^N */
@@ -150,12 +150,12 @@ static void decode_clb_far_below(gen_t *g) {
     c.parent_scale = c.scale;
     c.lb_mod = 0;
     for (size_t i = 0; i < sizeof ds / sizeof ds[0]; i++) {
-        int eu = c.scale + ds[i] + 150; /* biased exponent of clb */
-        if (eu < 1 || eu > 254) continue;
+        int eu = c.scale + ds[i] + CBVH_F32_ULP_BIAS; /* biased exponent of clb */
+        if (cbvh_f32_field_not_normal((uint32_t)eu)) continue;
         for (size_t f = 0; f < sizeof fracs / sizeof fracs[0]; f++)
             for (int neg = 0; neg < 2; neg++)
                 for (size_t k = 0; k < sizeof rs / sizeof rs[0]; k++) {
-                    c.clb = (neg ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << 23 | fracs[f];
+                    c.clb = (neg ? CBVH_F32_SIGN : 0u) | (uint32_t)eu << CBVH_F32_FRAC_BITS | fracs[f];
                     emit_decode(g, &c, rs[k][0], rs[k][1]);
                 }
     }

@@ -4,8 +4,7 @@
 
 #include <stdlib.h>
 
-/* Order-preserving integer key of a finite float (+0 and -0 both 0). */
-static int64_t fkey(cbvh_f32 x) { return (x & CBVH_F32_SIGN) ? -(int64_t)(x & ~CBVH_F32_SIGN) : (int64_t)x; }
+/* The inverse of cbvh_f32_key (0 -> +0). */
 static cbvh_f32 funkey(int64_t k) { return k < 0 ? CBVH_F32_SIGN | (uint32_t)-k : (uint32_t)k; }
 static const int64_t KEY_MAX = CBVH_F32_MAX;
 
@@ -24,7 +23,7 @@ static cbvh_f32 pat_mag(int i) {
     if (i == 0) return 0;
     if (i <= N_SUB) return pat_sub[i - 1];
     i -= 1 + N_SUB;
-    return mkf(0, pat_exp[i / N_FRAC], pat_frac[i % N_FRAC]);
+    return cbvh_f32_make(0, pat_exp[i / N_FRAC], pat_frac[i % N_FRAC]);
 }
 
 /* A handful of values whose pairs make boxes (incl. straddling zero). */
@@ -59,12 +58,12 @@ cbvh_f32 vg_rnd_float(rng_t *r) {
         break;
     }
     }
-    return mkf(sign, e, frac);
+    return cbvh_f32_make(sign, e, frac);
 }
 
 /* Random finite float in [a, b] (a <= b): near either end or anywhere. */
 static cbvh_f32 rnd_between(rng_t *r, cbvh_f32 a, cbvh_f32 b) {
-    int64_t ka = fkey(a), kb = fkey(b);
+    int64_t ka = cbvh_f32_key(a), kb = cbvh_f32_key(b);
     switch (rnd_below(r, 4)) {
     case 0: return funkey(ka + (int64_t)rnd_below(r, (uint64_t)(kb - ka < 16 ? kb - ka + 1 : 16)));
     case 1: return funkey(kb - (int64_t)rnd_below(r, (uint64_t)(kb - ka < 16 ? kb - ka + 1 : 16)));
@@ -86,7 +85,7 @@ box_t vg_rnd_box(rng_t *r) {
         return b;
     }
     b.lo = vg_rnd_float(r);
-    int64_t k = fkey(b.lo), ext = (int64_t)rnd_below(r, (uint64_t)1 << rnd_below(r, 32));
+    int64_t k = cbvh_f32_key(b.lo), ext = (int64_t)rnd_below(r, (uint64_t)1 << rnd_below(r, 32));
     if (ext > KEY_MAX - k) ext = KEY_MAX - k;
     b.hi = funkey(k + ext);
     return b;
@@ -155,7 +154,7 @@ size_t vg_structured_boxes(box_t *out, size_t max, int step) {
     PUT(F_TWO40, up(F_TWO40));
     PUT(neg(up(F_TWO40)), neg(F_TWO40));
     PUT(F_TWO24, up(up(F_TWO24)));
-    PUT(mkf(0, 100, 0x123456), up(mkf(0, 100, 0x123456)));
+    PUT(cbvh_f32_make(0, 100, 0x123456), up(cbvh_f32_make(0, 100, 0x123456)));
     PUT(F_NEG_0_4, F_NEG_0_4);
     PUT(down(F_NEG_0_4), up(F_NEG_0_4));
     PUT(0xBED1EB85 /* -0.41 */, 0xBEC7AE14 /* -0.39 */);
@@ -208,7 +207,7 @@ cbvh_f32 vg_rnd_f32_in(rng_t *r, int elo, int ehi) {
     int sign = (int)rnd_below(r, 2);
     int e = (int)rnd_range(r, elo, ehi);
     uint32_t frac = (uint32_t)rng_next(r);
-    return mkf(sign, e, frac);
+    return cbvh_f32_make(sign, e, frac);
 }
 cbvh_f32 vg_nudge(rng_t *r, cbvh_f32 x) {
     switch (rnd_below(r, 6)) {

@@ -56,9 +56,6 @@ static inline int64_t rnd_range(rng_t *r, int64_t lo, int64_t hi) {
 
 /* ---- binary32 patterns --------------------------------------------------- */
 
-static inline cbvh_f32 mkf(int sign, int e, uint32_t frac) {
-    return (sign ? CBVH_F32_SIGN : 0u) | (uint32_t)(e + 127) << 23 | (frac & CBVH_F32_FRAC);
-}
 static inline cbvh_f32 neg(cbvh_f32 x) { return x ^ CBVH_F32_SIGN; }
 static inline cbvh_f32 up(cbvh_f32 x) { return x == CBVH_F32_MAX ? x : cbvh_f32_next_up(x); }
 static inline cbvh_f32 down(cbvh_f32 x) { return x == (CBVH_F32_MAX | CBVH_F32_SIGN) ? x : cbvh_f32_next_down(x); }

@@ -327,9 +327,9 @@ static void reject_combinations_nodepair(gen_t *g, int decode) {
         child_t ch[2];
         for (int a = 0; a < 3; a++) {
             static const uint32_t lbm[3] = {1u, 0xFFFFFFFFu, 0x5u};
-            nd.ctx.axis[a] = (cbvh_axis_ctx){e + sh + a, e, lbm[a] & g->mask, a == 1 ? mkf(1, e + 3, 0) : 0};
+            nd.ctx.axis[a] = (cbvh_axis_ctx){e + sh + a, e, lbm[a] & g->mask, a == 1 ? cbvh_f32_make(1, e + 3, 0) : 0};
             for (int c = 0; c < 2; c++)
-                ch[c].b[a] = (box_t){mkf(0, e + 2, c ? 0x400000u : 0), mkf(0, e + 3, c ? 0 : 0x200000u)};
+                ch[c].b[a] = (box_t){cbvh_f32_make(0, e + 2, c ? 0x400000u : 0), cbvh_f32_make(0, e + 3, c ? 0 : 0x200000u)};
         }
         ch[0].flags = 0, ch[0].ptr = 5; /* inner */
         ch[1].flags = 1, ch[1].ptr = 9; /* leaf */

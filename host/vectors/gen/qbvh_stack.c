@@ -1,7 +1,7 @@
 /* Vectors of the QBVH stack unit (docs/qbvh.md §2). */
 #include "vectors/gen/gen.h"
 
-#include "cbvh/qbvh.h"
+#include "cbvh/qbvh_stack.h"
 
 static void emit_qstack(gen_t *g, uint32_t op, uint32_t first, uint32_t mask, const cbvh_f32 t[4], uint32_t entry) {
     uint32_t in[8] = {op, first, mask, t[0], t[1], t[2], t[3], entry};

@@ -150,7 +150,7 @@ static void exact_ray_box(gen_t *g, rng_t *rng, int count) {
                     d[a] = vg_rnd_f32_in(rng, -40, -10);
                 } else { /* far, aimed back at 0 (t = 2^(3-k)), sometimes an ulp off */
                     o[a] = vg_rnd_f32_in(rng, 40, 123);
-                    d[a] = vg_nudge(rng, (o[a] ^ CBVH_F32_SIGN) + ((k << 23) - (3u << 23)));
+                    d[a] = vg_nudge(rng, (o[a] ^ CBVH_F32_SIGN) + ((k << CBVH_F32_FRAC_BITS) - (3u << CBVH_F32_FRAC_BITS)));
                 }
             }
             break;

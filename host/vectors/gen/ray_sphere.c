@@ -192,7 +192,7 @@ static cbvh_f32 huge_f(rng_t *r, int signed_, int hi) {
     uint32_t frac = (uint32_t)rng_next(r);
     int e = (int)rnd_range(r, 120, hi);
     int sign = signed_ ? (int)rnd_below(r, 2) : 0;
-    return mkf(sign, e, frac);
+    return cbvh_f32_make(sign, e, frac);
 }
 
 /* Generator 7, after RTL mutation (docs/gateware.md): a unit that skips the
@@ -316,7 +316,7 @@ static void reject_combinations_ray_sphere(gen_t *g) {
             d[a] = huge_f(&hr, 1, 127);
             c[a] = huge_f(&hr, 1, top);
         }
-        if (k % 2) r = mkf(0, 126, (uint32_t)rng_next(&hr));
+        if (k % 2) r = cbvh_f32_make(0, 126, (uint32_t)rng_next(&hr));
         else r = huge_f(&hr, 0, 127);
         t0 = huge_f(&hr, 1, 127);
         t1 = huge_f(&hr, 0, 127);

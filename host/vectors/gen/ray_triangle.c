@@ -227,7 +227,7 @@ static void tri_wide_ties(gen_t *g) {
                             const cbvh_f32 tau = taus[ti], h = hs[hi];
                             /* in the unrotated frame (x, y, z); h - 2^23 halves h */
                             const cbvh_f32 d0[3] = {half ? tau * 2 : tau, 0, h};
-                            const cbvh_f32 o0[3] = {neg(tau), 0, neg(half ? h - (1u << 23) : h)};
+                            const cbvh_f32 o0[3] = {neg(tau), 0, neg(half ? h - (1u << CBVH_F32_FRAC_BITS) : h)};
                             const cbvh_f32 a0[3] = {h, tau, 0}, b0[3] = {0, h, tau};
                             emit_tri_frame(g, o0, d0, swap ? b0 : a0, swap ? a0 : b0, rot, mirror);
                         }

@@ -35,8 +35,8 @@ static void appended_estimate(gen_t *g) {
     for (size_t i = 0; i < sizeof ks / sizeof ks[0]; i++)
         for (int d = 1; d <= 4; d++)
             for (int m = 0; m < 2; m++) {
-                cbvh_f32 big = cbvh_f32_next_down(mkf(0, ks[i], 0)); /* pred(2^k) */
-                cbvh_f32 small = mkf(1, ks[i] - 24 - d, 0);        /* -2^(k-24-d) */
+                cbvh_f32 big = cbvh_f32_next_down(cbvh_f32_make(0, ks[i], 0)); /* pred(2^k) */
+                cbvh_f32 small = cbvh_f32_make(1, ks[i] - 24 - d, 0);        /* -2^(k-24-d) */
                 if (m)
                     emit_box2(g, neg(big), neg(small)); /* [-pred(2^k), 2^(k-24-d)] */
                 else

@@ -24,6 +24,7 @@
 
 #define CBVH_N_MIN 3
 #define CBVH_N_MAX 10
+#define CBVH_N_DEFAULT 6            /* the paper's N: 36 coordinate bits + leaf + 27-bit pointer = 64 */
 #define CBVH_SCALE_FLOOR (-126)     /* finest grid the hardware represents */
 #define CBVH_SCALE_CEIL 126         /* coarsest scale any finite box needs */
 #define CBVH_MIN_SCALE_DEFAULT (-30) /* paper, Sec. 5.1 */

@@ -90,9 +90,4 @@ cbvh_unit_path cbvh_ray_triangle_path(const cbvh_ray *ray, const cbvh_f32 v0[3],
                                       const cbvh_f32 v2[3]);
 cbvh_unit_path cbvh_ray_sphere_path(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r);
 
-/* Total order key of a binary32 value incl. +-Inf (+0 == -0); NaN not allowed. */
-static inline int64_t cbvh_f32_key(cbvh_f32 x) {
-    return (x & CBVH_F32_SIGN) ? -(int64_t)(x & ~CBVH_F32_SIGN) : (int64_t)x;
-}
-
 #endif

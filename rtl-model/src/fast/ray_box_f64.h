@@ -301,9 +301,9 @@ static inline cbvh_rbf_axis cbvh_rbf_axis_prep(cbvh_f32 clb, int scale) {
         r.exact = 1;
         return r;
     }
-    uint32_t eu = mag >> 23;
-    int d = (eu ? (int)eu - 150 : -149) - scale;
-    r.exact = eu != 0xFFu && d >= -42 && d <= 29;
+    uint32_t eu = cbvh_f32_exp_field(mag);
+    int d = (eu ? (int)eu - CBVH_F32_ULP_BIAS : CBVH_F32_SUB_EXP) - scale;
+    r.exact = eu != CBVH_F32_EXP_FIELD_MAX && d >= -42 && d <= 29;
     r.u = cbvh_rbf_f32(clb);
     return r;
 }

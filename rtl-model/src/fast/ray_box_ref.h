@@ -98,7 +98,7 @@ static inline void cbvh_ref_prepare32(const cbvh_ray *ray, cbvh_ref_ray *r) {
      * is above 2^62's): |o| <= 2^62 and 2^-62 <= |d| <= 2^62 */
     uint32_t small = !(cbvh_float_of(ray->tmin) < 0);
     for (int a = 0; a < 3; a++) {
-        uint32_t mo = ray->o[a] & 0x7FFFFFFFu, md = ray->d[a] & 0x7FFFFFFFu;
+        uint32_t mo = ray->o[a] & ~CBVH_F32_SIGN, md = ray->d[a] & ~CBVH_F32_SIGN;
         small &= (mo <= CBVH_REF32_LIMIT_BITS) & (md - CBVH_REF32_RLIMIT_BITS <= CBVH_REF32_LIMIT_BITS - CBVH_REF32_RLIMIT_BITS);
         float d = cbvh_float_of(ray->d[a]);
         r->o32[a] = cbvh_float_of(ray->o[a]);

@@ -20,8 +20,8 @@ static inline cbvh_f32 trunc_f32(double x) {
     uint64_t b;
     memcpy(&b, &x, sizeof b);
     int e = (int)(b >> 52 & 0x7FF) - 1023;
-    if (e < -126 || e > 127 || (b >> 63)) return 0;
-    return (cbvh_f32)((uint32_t)(e + 127) << 23 | (uint32_t)((b & 0xFFFFFFFFFFFFFull) >> 29));
+    if (e < CBVH_F32_EMIN || e > CBVH_F32_EMAX || (b >> 63)) return 0;
+    return cbvh_f32_make(0, e, (uint32_t)((b & 0xFFFFFFFFFFFFFull) >> 29)); /* the top 23 of 52 fraction bits */
 }
 
 /* The binary32 truncation of the exact quotient a/b, given binary64

@@ -36,11 +36,13 @@ static inline int64_t cbvh_fast_floor_shift(int64_t v, int d) {
  * than the bounds' common alignment (k not computed).  0: not handled. */
 static inline int cbvh_scale_estimate_fast_nm(int n, int ms, cbvh_f32 lb, cbvh_f32 ub, int *scale, int64_t *k,
                                               int64_t *ku) {
-    uint32_t el = (lb >> 23) & 0xFFu, eu = (ub >> 23) & 0xFFu;
+    uint32_t el = cbvh_f32_exp_field(lb), eu = cbvh_f32_exp_field(ub);
     int dx = (int)el - (int)eu;
-    if (el - 1u > 253u || eu - 1u > 253u || (uint32_t)(dx + CBVH_WIDTH_SPAN) > 2u * CBVH_WIDTH_SPAN) return 0;
-    int64_t ml = (int64_t)((lb & CBVH_F32_FRAC) | 0x800000u), mu = (int64_t)((ub & CBVH_F32_FRAC) | 0x800000u);
-    int xlo = (int)(dx < 0 ? el : eu) - 150; /* the lower exponent */
+    if (cbvh_f32_field_not_normal(el) || cbvh_f32_field_not_normal(eu) ||
+        (uint32_t)(dx + CBVH_WIDTH_SPAN) > 2u * CBVH_WIDTH_SPAN)
+        return 0;
+    int64_t ml = (int64_t)cbvh_f32_normal_sig(lb), mu = (int64_t)cbvh_f32_normal_sig(ub);
+    int xlo = (int)(dx < 0 ? el : eu) - CBVH_F32_ULP_BIAS; /* the lower exponent */
     int64_t vl = (lb & CBVH_F32_SIGN ? -ml : ml) * (INT64_C(1) << (dx > 0 ? dx : 0));
     int64_t vu = (ub & CBVH_F32_SIGN ? -mu : mu) * (INT64_C(1) << (dx < 0 ? -dx : 0));
     if (vl >= vu) return 0; /* inverted or a point */
@@ -87,11 +89,11 @@ static inline int cbvh_scale_estimate_fast(const cbvh_params *p, cbvh_f32 lb, cb
  * cbvh_grid_pack_signed, when needed.) */
 static inline int cbvh_fast_code(int n, int ms, int e, int64_t k, int64_t ku, uint32_t *lb_mod, uint32_t *ub_mod,
                                  int *child_scale) {
-    uint64_t cells = (uint64_t)(ku + 1 - k);
+    uint64_t cells = (uint64_t)(ku + 1 - k); /* 1 .. 2^62 */
     uint32_t mask = (1u << n) - 1u;
     *lb_mod = (uint32_t)(uint64_t)k & mask;
     *ub_mod = (uint32_t)(uint64_t)(ku + 1) & mask;
-    int cs = e - n + cbvh_grid_bitlen(cells - 1u);
+    int cs = e - n + cbvh_grid_bitlen63(cells - 1u);
     *child_scale = cs < ms ? ms : cs;
     return cells - 1u < (UINT64_C(1) << n); /* 1 <= cells <= 2^N */
 }
@@ -117,22 +119,52 @@ static inline void cbvh_fast_put_node(int n, uint64_t codes, int leaf, uint32_t 
     if (n > 6) cbvh_fast_store_le32(bytes + 8, (uint32_t)((uint64_t)ptr >> (64 - pp))); /* the rest of 96 bits */
 }
 
+/* An unsigned key that orders the finite nonzero binary32 values (negative
+ * patterns inverted): a < b iff key(a) < key(b).  -0 sorts below +0, so a
+ * fast path that takes only key(lb) <= key(ub) sends [+0, -0] (a valid
+ * point box) to the general path. */
+static inline uint32_t cbvh_fast_order_key(cbvh_f32 x) { return x ^ ((0u - (x >> 31)) >> 1) ^ CBVH_F32_SIGN; }
+
+/* Whether the grid step 2^e lies inside the significand of x: x normal and
+ * d = e - (lsb exponent of x) in [1, 23], d returned as unsigned.  Then
+ * 2^e <= |x| < 2^(e+24), so floor(x / 2^e) is nonzero and below 2^24 in
+ * magnitude. */
+static inline int cbvh_fast_in_sig(cbvh_f32 x, int e, uint32_t *d) {
+    uint32_t ex = cbvh_f32_exp_field(x);
+    *d = (uint32_t)(e + CBVH_F32_ULP_BIAS) - ex;
+    return !(cbvh_f32_field_not_normal(ex) | (*d - 1u > CBVH_F32_FRAC_BITS - 1u));
+}
+
+/* floor(x / 2^e) when cbvh_fast_in_sig(x, e, &d): floor(v / 2^d) of the
+ * signed significand v by the offset trick, as cbvh_fast_floor_shift. */
+static inline int64_t cbvh_fast_floor_in_sig(cbvh_f32 x, uint32_t d) {
+    uint32_t s = 0u - (x >> 31);                                      /* all ones if negative */
+    uint32_t v = ((cbvh_f32_normal_sig(x) ^ s) - s) + (1u << 30);    /* signed significand + 2^30 */
+    return (int64_t)(v >> d) - (int64_t)((1u << 30) >> d);
+}
+
+/* floor(x / 2^e) 2^e, the grid line at or below x, when
+ * cbvh_fast_in_sig(x, e, &d): x with its d low significand bits cleared
+ * (x > 0), or its magnitude rounded up to a multiple of 2^d in the bit
+ * pattern (x < 0; a carry moves into the exponent field and gives the exact
+ * power of two, or the -Inf pattern for -2^128).  Exact: it is the binary32
+ * value k 2^e itself (or -Inf for -2^128, which is RD of it). */
+static inline cbvh_f32 cbvh_fast_grid_below_in_sig(cbvh_f32 x, uint32_t d) {
+    uint32_t low = (1u << d) - 1u, s = 0u - (x >> 31);
+    return (((x & ~CBVH_F32_SIGN) + (low & s)) & ~low) | (x & CBVH_F32_SIGN);
+}
+
 /* floor(x / 2^e) for a finite x and e in [-126, 126]: exact, or 0 when x's
  * lsb lies more than 37 binades above 2^e (cbvh_grid_floor's "huge").  Fast
- * for a normal x whose grid step falls inside its significand
- * (d = e - lsb exponent in [1, 23]): floor(v / 2^d) of the signed
- * significand v by the offset trick, as cbvh_fast_floor_shift. */
+ * when cbvh_fast_in_sig. */
 static inline int cbvh_fast_floor(cbvh_f32 x, int e, int64_t *k) {
-    uint32_t ex = (x >> 23) & 0xFFu;
-    uint32_t d = (uint32_t)(e + 150) - ex;
-    if ((ex - 1u > 253u) | (d - 1u > 22u)) {
+    uint32_t d;
+    if (!cbvh_fast_in_sig(x, e, &d)) {
         int huge;
         *k = cbvh_grid_floor(x, e, &huge);
         return !huge;
     }
-    uint32_t s = 0u - (x >> 31);                                     /* all ones if negative */
-    uint32_t v = ((((x & CBVH_F32_FRAC) | 0x800000u) ^ s) - s) + (1u << 30); /* signed significand + 2^30 */
-    *k = (int64_t)(v >> d) - (int64_t)((1u << 30) >> d);
+    *k = cbvh_fast_floor_in_sig(x, d);
     return 1;
 }
 

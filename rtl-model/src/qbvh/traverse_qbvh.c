@@ -9,17 +9,11 @@
 #include "cbvh/qbvh.h"
 #include "traverse/traverse_common.h"
 
-static cbvh_f32 bits(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-
 static int box(trav_state *qs, const cbvh_qbvh *q, uint32_t i, cbvh_box_result *r) {
     cbvh_f32 lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
-        lo[a] = bits(q->bmin[i][a]);
-        hi[a] = bits(q->bmax[i][a]);
+        lo[a] = cbvh_f32_of(q->bmin[i][a]);
+        hi[a] = cbvh_f32_of(q->bmax[i][a]);
     }
     qs->s.box_tests++;
     return cbvh_ray_box_float_prep(&qs->prep, trav_box_tmax(qs), qs->M, lo, hi, r) == 0 && r->hit;

@@ -31,16 +31,6 @@ void cbvh_bsh_free(cbvh_bsh *h) {
     memset(h, 0, sizeof *h);
 }
 
-static cbvh_f32 f2b(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float b2f(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
 
 static int encloses(const cbvh_f32 sph[4], const float v[3]);
 
@@ -72,7 +62,7 @@ static int radius_up(const cbvh_tri *tris, const uint32_t *ids, uint32_t n, cons
     for (;;) {
         float g = nextafterf(f, 0.0f);
         if ((double)g * g < m * (1.0 - 0x1p-49)) break; /* g^2 is exact: g is too small */
-        cbvh_f32 sph[4] = {f2b(c[0]), f2b(c[1]), f2b(c[2]), f2b(g)};
+        cbvh_f32 sph[4] = {cbvh_f32_of(c[0]), cbvh_f32_of(c[1]), cbvh_f32_of(c[2]), cbvh_f32_of(g)};
         int all = 1;
         for (uint32_t i = 0; i < n && all; i++)
             for (int k = 0; k < 3 && all; k++) all = encloses(sph, tris[ids[i]].v[k]);
@@ -80,7 +70,7 @@ static int radius_up(const cbvh_tri *tris, const uint32_t *ids, uint32_t n, cons
         f = g;
         if (g == 0) break;
     }
-    *r = f2b(f);
+    *r = cbvh_f32_of(f);
     return 0;
 }
 
@@ -148,7 +138,7 @@ int cbvh_bsh_build(const cbvh_scene *s, const cbvh_bsh_params *p, cbvh_bsh *out,
             snprintf(err, errlen, "bsh: a bounding sphere radius exceeds binary32 (scene extent too close to FLT_MAX)");
             goto fail;
         }
-        for (int a = 0; a < 3; a++) out->sphere[w.node][a] = f2b(c[a]);
+        for (int a = 0; a < 3; a++) out->sphere[w.node][a] = cbvh_f32_of(c[a]);
         out->sphere[w.node][3] = r;
         out->first_tri[w.node] = ntid;
         if (cnt <= p->leaf_max || w.depth >= p->max_depth) {
@@ -158,7 +148,7 @@ int cbvh_bsh_build(const cbvh_scene *s, const cbvh_bsh_params *p, cbvh_bsh *out,
             continue;
         }
         /* Big triangles stay; the others go to the octant of their centroid. */
-        double rn = b2f(r);
+        double rn = cbvh_float_of(r);
         uint32_t gcount[8] = {0}, nbig = 0;
         for (uint32_t i = 0; i < cnt; i++) {
             const cbvh_tri *t = &T[ids[i]];
@@ -234,7 +224,7 @@ static int encloses(const cbvh_f32 sph[4], const float v[3]) {
     cbvh_xw s, d, p, cc;
     cbvh_xw_zero(&s);
     for (int a = 0; a < 3; a++) {
-        cbvh_xw_from_f32(&d, f2b(v[a]));
+        cbvh_xw_from_f32(&d, cbvh_f32_of(v[a]));
         cbvh_xw_from_f32(&cc, sph[a]);
         cbvh_xw_sub(&d, &d, &cc);
         cbvh_xw_mul(&p, &d, &d);

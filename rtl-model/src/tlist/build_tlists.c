@@ -10,16 +10,6 @@
 
 #include "cbvh/tlist.h"
 
-static cbvh_f32 f2b(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-static float b2f(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
 
 int cbvh_tlist_cone(int nlists, int l, float dir[3], float gen[6][3]) {
     int n = 0;
@@ -100,9 +90,9 @@ int cbvh_tlist_culled(int nlists, int l, const cbvh_tri *t) {
     int ng = cbvh_tlist_cone(nlists, l, dir, gen);
     cbvh_f32 v[3][3];
     for (int k = 0; k < 3; k++)
-        for (int a = 0; a < 3; a++) v[k][a] = f2b(t->v[k][a]);
+        for (int a = 0; a < 3; a++) v[k][a] = cbvh_f32_of(t->v[k][a]);
     for (int g = 0; g < ng; g++) {
-        cbvh_f32 d[3] = {f2b(gen[g][0]), f2b(gen[g][1]), f2b(gen[g][2])};
+        cbvh_f32 d[3] = {cbvh_f32_of(gen[g][0]), cbvh_f32_of(gen[g][1]), cbvh_f32_of(gen[g][2])};
         if (cbvh_tri_facing(d, v[0], v[1], v[2]) > 0) return 0; /* some direction of the cone sees the front */
     }
     return 1;
@@ -137,8 +127,8 @@ typedef struct {
 
 static double sphere_key(const flat *F, uint32_t node) {
     const cbvh_f32 *s = F->h->sphere[node];
-    double c = F->dir[0] * b2f(s[0]) + F->dir[1] * b2f(s[1]) + F->dir[2] * b2f(s[2]);
-    double r = (double)b2f(s[3]) * F->dlen;
+    double c = F->dir[0] * cbvh_float_of(s[0]) + F->dir[1] * cbvh_float_of(s[1]) + F->dir[2] * cbvh_float_of(s[2]);
+    double r = (double)cbvh_float_of(s[3]) * F->dlen;
     return F->latest ? c + r : c - r;
 }
 

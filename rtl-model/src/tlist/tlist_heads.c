@@ -18,16 +18,6 @@
 
 #include "cbvh/tlist.h"
 
-static float b2f(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-static cbvh_f32 f2b(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
 
 /* Reachable points satisfy (x - p0) . m >= -slack_dist * |m| (true m), with
  * m known as md up to an absolute error err[a] per component.  For frustum
@@ -60,7 +50,7 @@ static int ball_outside(const halfspace *h, const double c[3], double r) {
 
 static int element_outside(const halfspace *hs, int nh, const cbvh_tlist_elem *e, const cbvh_tri *tris) {
     if (e->escape >= 2 || e->escape == -1) {
-        double c[3] = {b2f(e->data[0]), b2f(e->data[1]), b2f(e->data[2])}, r = b2f(e->data[3]);
+        double c[3] = {cbvh_float_of(e->data[0]), cbvh_float_of(e->data[1]), cbvh_float_of(e->data[2])}, r = cbvh_float_of(e->data[3]);
         for (int k = 0; k < nh; k++)
             if (ball_outside(&hs[k], c, r)) return 1;
         return 0;
@@ -195,7 +185,7 @@ uint32_t cbvh_tlist_poly_head(const cbvh_tlists *L, int l, uint32_t from, const 
     if (ray->tmin & CBVH_F32_SIGN && !cbvh_f32_is_zero(ray->tmin)) return 0;
     cbvh_f32 v[3][3];
     for (int k = 0; k < 3; k++)
-        for (int a = 0; a < 3; a++) v[k][a] = f2b(tris[from].v[k][a]);
+        for (int a = 0; a < 3; a++) v[k][a] = cbvh_f32_of(tris[from].v[k][a]);
     if (cbvh_tri_facing(ray->d, v[0], v[1], v[2]) > 0) return 0; /* heads the back side: not covered */
     return L->poly_head[(size_t)from * L->p.nlists + l];
 }

@@ -6,19 +6,13 @@
 #include "fast/ray_box_f64.h"
 #include "traverse/traverse_common.h"
 
-static cbvh_f32 bits(float f) {
-    cbvh_f32 b;
-    memcpy(&b, &f, sizeof b);
-    return b;
-}
-
 /* The ray-box unit itself on node n's box with culling bound tmax: hit, and
  * t_near (for the boxes the binary64 filter leaves undecided). */
 static int unit_box(trav_state *ts, const cbvh_bvh_node *n, cbvh_f32 tmax, double *t_near) {
     cbvh_f32 flo[3], fhi[3];
     for (int a = 0; a < 3; a++) {
-        flo[a] = bits(n->lo[a]);
-        fhi[a] = bits(n->hi[a]);
+        flo[a] = cbvh_f32_of(n->lo[a]);
+        fhi[a] = cbvh_f32_of(n->hi[a]);
     }
     cbvh_box_result r;
     if (cbvh_ray_box_float_prep(trav_prep(ts), tmax, ts->M, flo, fhi, &r) != 0 || !r.hit) return 0;

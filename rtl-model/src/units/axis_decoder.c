@@ -81,11 +81,11 @@ uint32_t cbvh_axis_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_ax
                           uint32_t ub_code, cbvh_axis_code *out) {
     int n = p->quant_bits, ms = p->min_scale, e = ctx->scale;
     uint32_t mask = (1u << (n & 31)) - 1u;
-    uint32_t eu = (ctx->clb >> 23) & 0xFFu;
-    int d = (int)eu - 150 - e; /* u's lsb exponent minus the scale */
+    uint32_t eu = cbvh_f32_exp_field(ctx->clb);
+    int d = (int)eu - CBVH_F32_ULP_BIAS - e; /* u's lsb exponent minus the scale */
     if ((uint32_t)(n - CBVH_N_MIN) > (uint32_t)(CBVH_N_MAX - CBVH_N_MIN) || ms < CBVH_SCALE_FLOOR ||
         ms > CBVH_SCALE_CEIL || e < ms || ctx->parent_scale > CBVH_SCALE_CEIL || ctx->parent_scale < e ||
-        ctx->lb_mod > mask || lb_code > mask || ub_code > mask || eu - 1u > 253u || d < -36 || d > 36)
+        ctx->lb_mod > mask || lb_code > mask || ub_code > mask || cbvh_f32_field_not_normal(eu) || d < -36 || d > 36)
         return decode_general(p, enc, ctx, lb_code, ub_code, out);
 
     int shift = ctx->parent_scale - e;
@@ -98,7 +98,7 @@ uint32_t cbvh_axis_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_ax
     if (s == 0) s = mask + 1u;
     if (r >= s) return decode_general(p, enc, ctx, lb_code, ub_code, out);
 
-    int64_t u = (int64_t)((ctx->clb & CBVH_F32_FRAC) | 0x800000u);
+    int64_t u = (int64_t)cbvh_f32_normal_sig(ctx->clb);
     if (ctx->clb & CBVH_F32_SIGN) u = -u;
     int lo;
     int64_t sr, ss;

@@ -14,9 +14,7 @@ cbvh_f32 cbvh_f32_add_dyadic(int64_t a, int ea, int64_t b, int eb, cbvh_rnd mode
 }
 
 int cbvh_f32_cmp(cbvh_f32 a, cbvh_f32 b) {
-    /* map to a monotone signed key; both zeros map to 0 */
-    int64_t ka = (a & CBVH_F32_SIGN) ? -(int64_t)(a & ~CBVH_F32_SIGN) : (int64_t)a;
-    int64_t kb = (b & CBVH_F32_SIGN) ? -(int64_t)(b & ~CBVH_F32_SIGN) : (int64_t)b;
+    int64_t ka = cbvh_f32_key(a), kb = cbvh_f32_key(b); /* monotone; both zeros map to 0 */
     return (ka > kb) - (ka < kb);
 }
 

@@ -20,6 +20,15 @@ static inline int cbvh_grid_bitlen(uint64_t x) {
 #endif
 }
 
+/* The same for x < 2^63, branch-free. */
+static inline int cbvh_grid_bitlen63(uint64_t x) {
+#if defined(__GNUC__)
+    return 63 - __builtin_clzll(2u * x + 1u);
+#else
+    return cbvh_bitlen64(x);
+#endif
+}
+
 /* cbvh_params_check, inline. */
 static inline uint32_t cbvh_grid_params_check(const cbvh_params *p) {
     if (p->quant_bits < CBVH_N_MIN || p->quant_bits > CBVH_N_MAX) return CBVH_ST_BAD_PARAM;
@@ -27,22 +36,16 @@ static inline uint32_t cbvh_grid_params_check(const cbvh_params *p) {
     return 0;
 }
 
-/* Monotone signed key of a finite pattern (+0 and -0 -> 0): a > b as floats
- * iff key(a) > key(b).  Same order as cbvh_f32_cmp. */
-static inline int64_t cbvh_grid_key(cbvh_f32 b) {
-    return (b & CBVH_F32_SIGN) ? -(int64_t)(b & ~CBVH_F32_SIGN) : (int64_t)b;
-}
-
 /* break_float (see cbvh_f32_break). */
 static inline void cbvh_grid_break(cbvh_f32 b, int *sign, uint32_t *sig, int *exp) {
-    uint32_t e = (b >> 23) & 0xFFu;
+    uint32_t e = cbvh_f32_exp_field(b);
     *sign = (int)(b >> 31);
     if (e == 0) {
         *sig = b & CBVH_F32_FRAC;
-        *exp = -149;
+        *exp = CBVH_F32_SUB_EXP;
     } else {
-        *sig = (b & CBVH_F32_FRAC) | 0x800000u;
-        *exp = (int)e - 150;
+        *sig = cbvh_f32_normal_sig(b);
+        *exp = (int)e - CBVH_F32_ULP_BIAS;
     }
 }
 
@@ -51,7 +54,7 @@ static inline cbvh_f32 cbvh_grid_pack(int neg, uint64_t mag, int exp, cbvh_rnd m
     if (mag == 0) return 0;
     int away = neg ? (mode == CBVH_RND_DOWN) : (mode == CBVH_RND_UP);
     int top = exp + cbvh_grid_bitlen(mag) - 1; /* value in [2^top, 2^(top+1)) */
-    int lsb = top >= -126 ? top - 23 : -149;   /* exponent of the result's ulp */
+    int lsb = top >= CBVH_F32_EMIN ? top - CBVH_F32_FRAC_BITS : CBVH_F32_SUB_EXP; /* exponent of the result's ulp */
     uint64_t q;
     if (exp >= lsb) {
         q = mag << (exp - lsb); /* exact: fits in 24 bits */
@@ -66,17 +69,17 @@ static inline cbvh_f32 cbvh_grid_pack(int neg, uint64_t mag, int exp, cbvh_rnd m
             rem = mag & ((UINT64_C(1) << d) - 1);
         }
         if (rem && away) q++;
-        if (q == (UINT64_C(1) << 24)) { /* carry into the next binade */
+        if (q == (uint64_t)CBVH_F32_HIDDEN << 1) { /* carry into the next binade */
             q >>= 1;
             lsb++;
         }
     }
     uint32_t sign = neg ? CBVH_F32_SIGN : 0;
     if (q == 0) return away ? (sign | 1u) : 0;                /* below the smallest subnormal */
-    if (q < (UINT64_C(1) << 23)) return sign | (uint32_t)q;   /* subnormal (lsb == -149) */
-    int biased = lsb + 150;
-    if (biased >= 255) return away ? (sign | CBVH_F32_POS_INF) : (sign | CBVH_F32_MAX);
-    return sign | ((uint32_t)biased << 23) | ((uint32_t)q & CBVH_F32_FRAC);
+    if (q < CBVH_F32_HIDDEN) return sign | (uint32_t)q;       /* subnormal (lsb == -149) */
+    int biased = lsb + CBVH_F32_ULP_BIAS;
+    if (biased >= (int)CBVH_F32_EXP_FIELD_MAX) return away ? (sign | CBVH_F32_POS_INF) : (sign | CBVH_F32_MAX);
+    return sign | ((uint32_t)biased << CBVH_F32_FRAC_BITS) | ((uint32_t)q & CBVH_F32_FRAC);
 }
 
 /* RD/RU of the integer v times 2^exp. */

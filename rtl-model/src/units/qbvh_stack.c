@@ -1,9 +1,7 @@
 /* Unit 8: the QBVH compressed stack entry (seed 000, Bogolepov & Ulyanov) and
  * the 5-comparator sort of the children's hit times.  Integer-only; spec and
  * errata of the printed pseudocode: docs/qbvh.md. */
-#include "cbvh/qbvh.h"
-
-#include "cbvh/traversal_units.h"
+#include "cbvh/qbvh_stack.h"
 
 /* Comparator key (missed, t, index): a total order, so the network's output
  * is the unique sorted permutation whatever the ties. */
@@ -26,7 +24,7 @@ uint32_t cbvh_qstack_sort(const uint32_t t[4], uint32_t hit_mask, uint8_t order[
     uint32_t st = 0;
     if (hit_mask > 15u) st |= CBVH_ST_BAD_PARAM;
     for (int c = 0; c < 4 && !st; c++)
-        if (((hit_mask >> c) & 1u) && (t[c] & 0x7FFFFFFFu) > 0x7F800000u) st |= CBVH_ST_NAN_INF;
+        if (((hit_mask >> c) & 1u) && cbvh_f32_is_nan(t[c])) st |= CBVH_ST_NAN_INF;
     if (st) {
         for (int c = 0; c < 4; c++) order[c] = 0;
         *nhit = 0;

@@ -231,7 +231,7 @@ void cbvh_rb_prepare(const cbvh_ray *ray, cbvh_rb_ray *p) {
         ax->dneg = s;
         ax->de = e - sh;
         ax->R = (uint64_t)(((u128)1 << 86) / ds);
-        ax->rexact = ds == (UINT64_C(1) << 23);
+        ax->rexact = ds == CBVH_F32_HIDDEN; /* a power of two */
     }
 #endif
 }

@@ -130,11 +130,7 @@ static int exact_decide(const cbvh_ray *ray, const cbvh_f32 c[3], cbvh_f32 r) {
  *
  * A fused multiply-add only removes roundings, so the bound also holds if the
  * compiler contracts; the file is compiled with -ffp-contract=off anyway. */
-static double f32d(cbvh_f32 b) {
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return (double)f;
-}
+static double f32d(cbvh_f32 b) { return (double)cbvh_float_of(b); }
 /* |x| by clearing the sign bit: no data-dependent branch (random signs
  * would mispredict), and exact. */
 static double dabs(double x) {

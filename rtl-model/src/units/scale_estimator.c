@@ -21,7 +21,7 @@ static inline int fits(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e) {
     int hl, hu;
     int64_t kl = cbvh_grid_floor(lb, e, &hl);
     int64_t ku = cbvh_grid_floor(ub, e, &hu);
-    if (hl || hu) return cbvh_grid_key(lb) == cbvh_grid_key(ub); /* see cbvh_grid_floor */
+    if (hl || hu) return cbvh_f32_key(lb) == cbvh_f32_key(ub); /* see cbvh_grid_floor */
     return ku + 1 - kl <= (INT64_C(1) << p->quant_bits);
 }
 
@@ -38,7 +38,7 @@ static uint32_t estimate_general(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub,
     uint32_t st = cbvh_grid_params_check(p);
     if (st) return st;
     if (cbvh_f32_is_nan_or_inf(lb) || cbvh_f32_is_nan_or_inf(ub)) return CBVH_ST_NAN_INF;
-    int64_t kl = cbvh_grid_key(lb), ku = cbvh_grid_key(ub);
+    int64_t kl = cbvh_f32_key(lb), ku = cbvh_f32_key(ub);
     if (kl > ku) return CBVH_ST_INVERTED;
     if (kl == ku) {
         *scale = p->min_scale;

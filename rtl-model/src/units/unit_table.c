@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "cbvh/traversal_units.h"
-#include "cbvh/qbvh.h"
+#include "cbvh/qbvh_stack.h"
 
 static void add(cbvh_field *f, int *n, const char *name, int digits) {
     f[*n].name = name;
