@@ -290,12 +290,10 @@ static inline uint32_t est_axis(const cbvh_params *p, int n, int ms, cbvh_f32 lb
 }
 
 /* The node's side of the fast path, per axis: its child grid cs, its lower
- * bound's code at cs (relative encoding), its window's first cell K =
- * floor(u / 2^cs) (u = RD(k 2^e) of its record) and the record itself. */
+ * bound's code at cs (relative encoding) and its record. */
 typedef struct {
     int cs[3];
     uint32_t pm[3];
-    int64_t kn[3];
     const bu_axis *ax;
 } bu_node;
 
@@ -319,15 +317,20 @@ static uint32_t axis_unit(const cbvh_params *p, const cbvh_bvh_node *cn, int a, 
     return st;
 }
 
-/* Whether the child's cells k .. ku leave the node's window K .. K + 2^N - 1
- * (the compressor's OUTSIDE, in the integers of the spec). */
-static inline int leaves_window(int n, int64_t k, int64_t ku, int64_t kn) {
-    return (k < kn) | (ku + 1 - kn > (INT64_C(1) << n));
+/* Nonzero unless the child's box lies inside its node's box (NaN too).  The
+ * fast path takes only such children: they lie in the window of the node's
+ * context, which is estimated from that box (datapath.md §6), so the
+ * compressor would not report OUTSIDE.  Any other child goes to the general
+ * path, where the units decide (a tree whose child leaves its node's window
+ * is refused there). */
+static inline int outside_box(const cbvh_bvh_node *n, const cbvh_bvh_node *cn) {
+    int out = 0;
+    for (int a = 0; a < 3; a++) out |= !(cn->lo[a] >= n->lo[a]) | !(cn->hi[a] <= n->hi[a]);
+    return out;
 }
 
 /* The code bits [0, 6N) of a leaf child at the parent's scales cs: its box
- * floored directly.  0, or nonzero: the box does not fit or leaves the
- * node's window (general path). */
+ * floored directly.  0, or nonzero: the box does not fit (general path). */
 static inline int leaf_codes(const cbvh_params *p, int n, const cbvh_bvh_node *cn, const bu_node *nd, uint64_t *w) {
     int bad = 0;
     uint32_t mask = (1u << n) - 1u;
@@ -342,7 +345,6 @@ static inline int leaf_codes(const cbvh_params *p, int n, const cbvh_bvh_node *c
             continue;
         }
         bad |= (uint64_t)(ku - k) >= (UINT64_C(1) << n); /* cells = ku + 1 - k in 1..2^N */
-        bad |= leaves_window(n, k, ku, nd->kn[a]);
         acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm) & mask) << (2 * a * n) |
                (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm) & mask) << (2 * a * n + n);
     }
@@ -372,7 +374,6 @@ static inline int inner_codes(const cbvh_params *p, int n, int ms, const bu_rec 
         int64_t k = cbvh_fast_floor_shift(ra->k, d), ku = cbvh_fast_floor_shift(ra->ku, d);
         uint64_t cells = (uint64_t)(ku + 1 - k);
         bad |= cells - 1u >= (UINT64_C(1) << n);
-        bad |= leaves_window(n, k, ku, nd->kn[a]);
         ccs = cs - n + cbvh_grid_bitlen(cells - 1u);
         ccs = ccs < ms ? ms : ccs;
         dif |= ccs != ra->cs;
@@ -442,24 +443,16 @@ static inline int bu_step(cbvh_bu_stream *bs, const cbvh_bvh_node *n, const cbvh
         if (inner_children > sp) goto general; /* not a tree; the general path reports it */
         if (!cleaf[1]) cr[1] = &recs[sp - 1];
         if (!cleaf[0]) cr[0] = &recs[sp - 1 - !cleaf[1]];
-        int bad = 0;
+        int bad = outside_box(n, cn[0]) | outside_box(n, cn[1]);
         for (int a = 0; a < 3; a++)
             bad |= est_axis(p, nq, msc, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &rx.ax[a]) != 0;
         if (bad) goto general;
-        bu_node nd = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, rx.ax};
+        bu_node nd = {{0, 0, 0}, {0, 0, 0}, rx.ax};
         const int *cs = nd.cs;
         for (int a = 0; a < 3; a++) {
-            const bu_axis *ra = &rx.ax[a];
-            nd.cs[a] = ra->cs;
-            int shift = ra->e - ra->cs; /* 0 .. N */
-            if (rel) nd.pm[a] = shift >= nq ? 0 : (ra->lb_mod << shift) & qmask; /* relative: u's code at cs */
-            /* the window's first cell: u / 2^cs = k 2^shift (u = k 2^e), kept below 2^62 */
-            if (ra->exact) {
-                bad |= ra->k < -(INT64_C(1) << (61 - shift)) || ra->k >= (INT64_C(1) << (61 - shift));
-                nd.kn[a] = (int64_t)((uint64_t)ra->k << shift);
-            } else {
-                bad |= !cbvh_fast_floor(ra->clb, ra->cs, &nd.kn[a]);
-            }
+            nd.cs[a] = rx.ax[a].cs;
+            int shift = rx.ax[a].e - cs[a];
+            if (rel) nd.pm[a] = shift >= nq ? 0 : (rx.ax[a].lb_mod << shift) & qmask; /* relative: u's code at cs */
         }
         uint64_t w[2];
         int maybe[2] = {0, 0};
@@ -477,9 +470,11 @@ static inline int bu_step(cbvh_bu_stream *bs, const cbvh_bvh_node *n, const cbvh
             cbvh_f32 cub[3];
             rec_ctx(cr[c], &stored);
             for (int a = 0; a < 3; a++) {
+                /* the child lies in the node's box (outside_box), hence in its
+                 * window: its own lower bound as node_clb spares forming u */
                 cbvh_axis_code code;
-                cbvh_axis_compress(p, cbvh_f32_of(cn[c]->lo[a]), cbvh_f32_of(cn[c]->hi[a]), cs[a], axis_clb(&rx.ax[a]),
-                                   &code);
+                cbvh_f32 lo = cbvh_f32_of(cn[c]->lo[a]);
+                cbvh_axis_compress(p, lo, cbvh_f32_of(cn[c]->hi[a]), cs[a], lo, &code);
                 actual.axis[a] = cbvh_axis_child_ctx(&(cbvh_axis_ctx){rx.ax[a].e, cs[a], rx.ax[a].lb_mod, 0}, &code);
                 cub[a] = code.cub;
             }
