@@ -59,7 +59,7 @@ static void make_inputs(void) {
         x->ub = cbvh_f32_of(ub);
         if (cbvh_axis_root_ctx(&P, cbvh_f32_of(plb), cbvh_f32_of(pub), &x->ctx)) abort();
         cbvh_axis_code c;
-        if (cbvh_axis_compress(&P, x->lb, x->ub, x->ctx.scale, &c)) abort();
+        if (cbvh_axis_compress(&P, x->lb, x->ub, x->ctx.scale, x->ctx.clb, &c)) abort();
         for (int enc = 0; enc < 2; enc++)
             cbvh_axis_store_codes(&P, (cbvh_encoding)enc, &x->ctx, &c, &x->lc[enc], &x->uc[enc]);
     }
@@ -249,7 +249,7 @@ int main(int argc, char **argv) {
     double t_comp, t_dmod, t_drel, t_est, t_enc, t_dec, t_nl, t_nm, t_nd;
     TIME_LOOP(t_comp, 1, NB, {
         cbvh_axis_code c;
-        acc += cbvh_axis_compress(&P, in[i].lb, in[i].ub, in[i].ctx.scale, &c);
+        acc += cbvh_axis_compress(&P, in[i].lb, in[i].ub, in[i].ctx.scale, in[i].ctx.clb, &c);
         acc += SINK_CODE(c);
     });
     TIME_LOOP(t_nl, 1, NB, {

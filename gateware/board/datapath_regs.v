@@ -80,7 +80,7 @@ module cbvh_datapath_regs #(
 
     // shapes (rtl-model/src/units/unit_table.c): input and output words per unit
     localparam integer NIN1 = 2,  NOUT1 = 2;
-    localparam integer NIN2 = 3,  NOUT2 = 6;
+    localparam integer NIN2 = 4,  NOUT2 = 6;
     localparam integer NIN3 = 6,  NOUT3 = 6;
     localparam integer NIN4 = 28, NOUT4 = (N <= 6) ? 5 : 7;
     localparam integer NIN5 = (N <= 6) ? 16 : 18, NOUT5 = 35;
@@ -191,11 +191,12 @@ module cbvh_datapath_regs #(
             wire [N-1:0] lm, um;
             wire [7:0]   cs;
             wire [31:0]  clb, cub;
-            wire [6:0]   st;
+            wire [7:0]   st;
             cbvh_axis_compressor #(.N(N), .E_MIN(E_MIN)) u_cmp (
                 .lb(in_w[0*32 +: 32]), .ub(in_w[1*32 +: 32]), .scale(in_w[2*32 +: 8]),
+                .node_clb(in_w[3*32 +: 32]),
                 .lb_mod(lm), .ub_mod(um), .child_scale(cs), .clb(clb), .cub(cub), .status(st));
-            wire [NOUT2*32-1:0] o = {{25'd0, st}, cub, clb, {24'd0, cs},
+            wire [NOUT2*32-1:0] o = {{24'd0, st}, cub, clb, {24'd0, cs},
                                      {{(32-N){1'b0}}, um}, {{(32-N){1'b0}}, lm}};
             cbvh_board_pad #(.NW(NOUT2), .OW(OUT_WORDS)) u_pad (.o(o), .bus(u2_bus));
         end else begin : g_no_cmp

@@ -64,9 +64,9 @@ module tb_board_smoke;
     wire [5:0]  z_lm, z_um;
     wire [7:0]  z_cs;
     wire [31:0] z_clb, z_cub;
-    wire [6:0]  z_st;
+    wire [7:0]  z_st;
     cbvh_axis_compressor #(.N(6), .E_MIN(-30)) ref_cmp (
-        .lb(32'd0), .ub(32'd0), .scale(8'd0), .lb_mod(z_lm), .ub_mod(z_um),
+        .lb(32'd0), .ub(32'd0), .scale(8'd0), .node_clb(32'd0), .lb_mod(z_lm), .ub_mod(z_um),
         .child_scale(z_cs), .clb(z_clb), .cub(z_cub), .status(z_st));
 
     integer nchecks = 0;
@@ -217,7 +217,7 @@ module tb_board_smoke;
             enc = cfg[24] ? (ENC_REL != 0) : (ENC_MOD != 0);
             case (uu)
                 1: shape_exp = (B1 && ok) ? 32'h0202 : 0;
-                2: shape_exp = (B2 && ok) ? 32'h0603 : 0;
+                2: shape_exp = (B2 && ok) ? 32'h0604 : 0;
                 3: shape_exp = (B3 && ok && enc) ? 32'h0606 : 0;
                 4: shape_exp = (B4 && ok && enc) ? 32'h051C : 0;
                 5: shape_exp = (B5 && ok && enc) ? 32'h2310 : 0;
@@ -290,8 +290,8 @@ module tb_board_smoke;
         // axis_compress-N6-ms-30.vec, line 1
         reg_write(R_UNIT_SEL, 32'd2);
         if (B2) begin
-            nin = 3; nout = 6;
-            vin[0] = 32'h00000000; vin[1] = 32'h00000000; vin[2] = 32'hE2;
+            nin = 4; nout = 6;
+            vin[0] = 32'h00000000; vin[1] = 32'h00000000; vin[2] = 32'hE2; vin[3] = 32'h00000000;
             vout[0] = 32'h000; vout[1] = 32'h001; vout[2] = 32'hE2;
             vout[3] = 32'h00000000; vout[4] = 32'h30800000; vout[5] = 32'h00;
             run_vector;
@@ -317,7 +317,7 @@ module tb_board_smoke;
             expect_reg("OUT2 on zeros", 32'h208, {24'd0, z_cs});
             expect_reg("OUT3 on zeros", 32'h20C, z_clb);
             expect_reg("OUT4 on zeros", 32'h210, z_cub);
-            expect_reg("OUT5 on zeros", 32'h214, {25'd0, z_st});
+            expect_reg("OUT5 on zeros", 32'h214, {24'd0, z_st});
         end else begin
             run(32'd6);
         end

@@ -5,12 +5,15 @@
 //   lb_mod = k mod 2^N,  ub_mod = l mod 2^N
 //   child_scale = fits ? max(E_MIN, e - N + ceil(log2 cells)) : e
 //   clb = RD(k 2^e),  cub = RU(l 2^e)
+//   OUTSIDE = k < K or l > K + 2^N,  K = floor(node_clb / 2^e)   (the node's window)
 //
 // Cost notes: no wide integers are built. k 2^e is a binary32 (section 3; -2^128
 // comes out as the -Inf pattern), so clb and cub are masks and +-1 increments on the
 // bit pattern. Only W = N + 2 low bits of k and floor(q/2^e) are extracted; the
 // difference of the magnitude bit patterns decides whether those low bits give the
-// whole difference l - k (see the proof sketch at "close").
+// whole difference l - k (see the proof sketch at "close"). The window test uses
+// the same windows of K and the same closeness test on the pairs (p, u) and (u, q)
+// (module cbvh_axis_compressor_pair): no wide integer either.
 
 /* verilator lint_off DECLFILENAME */ // file name is fixed by the project layout
 module cbvh_axis_compressor #(
@@ -20,12 +23,13 @@ module cbvh_axis_compressor #(
     input  wire [31:0]  lb,          // p (binary32 bit pattern)
     input  wire [31:0]  ub,          // q
     input  wire [7:0]   scale,       // e, 8-bit two's complement
+    input  wire [31:0]  node_clb,    // u, the node's decoded lower bound (-Inf = -2^128)
     output wire [N-1:0] lb_mod,      // r^ = k mod 2^N
     output wire [N-1:0] ub_mod,      // s^ = l mod 2^N
     output wire [7:0]   child_scale,
     output wire [31:0]  clb,         // u = RD(k 2^e)
     output wire [31:0]  cub,         // v = RU(l 2^e)
-    output wire [6:0]   status
+    output wire [7:0]   status
 );
 /* verilator lint_on DECLFILENAME */
 
@@ -49,6 +53,15 @@ module cbvh_axis_compressor #(
     wire signed [9:0] q_d;
     wire [22:0]  q_mask;
     wire [W-1:0] q_f;
+    // u = node_clb: the -Inf pattern decomposes as 2^23 * 2^(255-150) = 2^128
+    wire         u_naninf, u_neg, u_big, u_sticky;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire         u_lt, u_le;              // only p and q need the decoded bounds
+    wire [22:0]  u_mask;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [7:0]   u_ee;
+    wire signed [9:0] u_d;
+    wire [W-1:0] u_f;
 
     cbvh_axis_compressor_bound #(.W(W)) u_p (
         .x(lb), .e(e), .nan_inf(p_nan), .neg(p_neg), .ee(p_ee), .d(p_d),
@@ -56,38 +69,28 @@ module cbvh_axis_compressor #(
     cbvh_axis_compressor_bound #(.W(W)) u_q (
         .x(ub), .e(e), .nan_inf(q_nan), .neg(q_neg), .ee(q_ee), .d(q_d),
         .mask(q_mask), .sticky(q_sticky), .lt(q_lt), .le(q_le), .big(q_big), .f(q_f));
+    cbvh_axis_compressor_bound #(.W(W)) u_u (
+        .x(node_clb), .e(e), .nan_inf(u_naninf), .neg(u_neg), .ee(u_ee), .d(u_d),
+        .mask(u_mask), .sticky(u_sticky), .lt(u_lt), .le(u_le), .big(u_big), .f(u_f));
+    wire u_nan = u_naninf & (node_clb != 32'hFF800000);  // NaN or +Inf; -Inf is -2^128
 
     // ---- codes: low W bits of k and kq = floor(q/2^e) ---------------------------
     // For x < 0: floor(x/2^e) = -(floor(|x|/2^e) + sticky) = ~f + !sticky (mod 2^W).
     wire [W-1:0] k_lo  = p_neg ? (~p_f + {{(W-1){1'b0}}, ~p_sticky}) : p_f;
     wire [W-1:0] kq_lo = q_neg ? (~q_f + {{(W-1){1'b0}}, ~q_sticky}) : q_f;
+    wire [W-1:0] ku_lo = u_neg ? (~u_f + {{(W-1){1'b0}}, ~u_sticky}) : u_f;  // K
     // dd = (kq - k) mod 2^W = cells - 1 whenever "close" holds.
     wire [W-1:0] dd    = kq_lo - k_lo;
 
     // ---- close: is kq - k < 2^W, so that dd is the true difference? -------------
-    // Neither bound big (|x| < 2^(e+W-1)): |k|, |kq| <= 2^(W-1), the difference is
-    // below 2^W. A big bound and the other of opposite sign: difference
-    // >= 2^(W-1) > 2^N, no fit. Same sign, magnitudes A <= B, B big: binades two or
-    // more apart give B - A > B/2 >= 2^(e+W-2), difference >= 2^N, no fit. One
-    // binade apart at most (both normal, as B big means B >= 2^-121): the
-    // magnitude-pattern difference P = pat(B) - pat(A) has X/2 <= P <= X, X = B - A
-    // in units of 2^expA. With T = N + e - expA, P <= 2^T holds when
-    // kq - k <= 2^N - 1 and fails when kq - k >= 2^W, which is all "fits" needs.
-    wire         same   = (p_neg == q_neg);
-    wire signed [9:0] a_d = p_neg ? q_d : p_d;            // e - expA
-    wire [8:0]   gq     = {1'b0, q_ee} - {1'b0, p_ee};
-    wire         gap_ok = (gq == 9'd0) || (gq == (p_neg ? 9'h1FF : 9'd1));
-    // pdiff = pat(q) - pat(p) (magnitudes); R = P for p, q >= 0, P - 1 for p, q < 0
-    // (a one's complement instead of a negation; P = 0 is caught separately)
-    wire [31:0]  pdiff  = {1'b0, ub[30:0]} - {1'b0, lb[30:0]};
-    wire [30:0]  r_x    = p_neg ? ~pdiff[30:0] : pdiff[30:0];
-    wire signed [9:0] t_x = a_d + NS10;                   // T
-    wire [4:0]   t_xc   = (t_x < 10'sd0) ? 5'd0 : (t_x > 10'sd31) ? 5'd31 : t_x[4:0];
-    wire [30:0]  x_low  = ~(31'h7FFFFFFF << t_xc);        // bits below 2^T
-    wire         pd_zero = ~|pdiff;                       // P = 0 (R would wrap)
-    // R < 2^T; for T < 0 only P = 0 passes (P - 1 < 2^T <=> P <= 2^T needs T >= 0)
-    wire         x_small = pd_zero | (~t_x[9] & ~|(r_x & ~x_low));
-    wire         close  = (~p_big & ~q_big) | (same & gap_ok & x_small);
+    // (module cbvh_axis_compressor_pair; it also orders p and q by value)
+    wire         close, p_gt_q;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire         p_lt_q_unused;
+    /* verilator lint_on UNUSEDSIGNAL */
+    cbvh_axis_compressor_pair #(.N(N)) u_pq (
+        .xm(lb[30:0]), .ym(ub[30:0]), .x_neg(p_neg), .y_neg(q_neg), .x_big(p_big), .y_big(q_big),
+        .x_ee(p_ee), .y_ee(q_ee), .x_d(p_d), .y_d(q_d), .close(close), .lt(p_lt_q_unused), .gt(p_gt_q));
 
     wire         fits  = close & ~|dd[W-1:N];
 
@@ -127,12 +130,29 @@ module cbvh_axis_compressor #(
                         : q_le   ? 32'd0
                         :          {1'b1, q_sticky ? q_trunc : q_down};
 
+    // ---- the node's window (section 6): inside iff K <= k and kq - K < 2^N -------
+    // p >= u: K <= k, and (u, q) is an ordered pair, so kq - K < 2^N iff close(u, q)
+    //         and its low bits say so (not close: kq - K >= 2^N);
+    // p < u:  k <= K, so inside needs k = K, i.e. close(p, u) with equal low bits
+    //         (not close: K - k >= 2^N), and then kq - K = cells - 1: fits.
+    wire         pu_close, p_lt_u, uq_close;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire         p_gt_u_unused, u_lt_q_unused, u_gt_q_unused;
+    /* verilator lint_on UNUSEDSIGNAL */
+    cbvh_axis_compressor_pair #(.N(N)) u_pu (
+        .xm(lb[30:0]), .ym(node_clb[30:0]), .x_neg(p_neg), .y_neg(u_neg), .x_big(p_big), .y_big(u_big),
+        .x_ee(p_ee), .y_ee(u_ee), .x_d(p_d), .y_d(u_d), .close(pu_close), .lt(p_lt_u), .gt(p_gt_u_unused));
+    cbvh_axis_compressor_pair #(.N(N)) u_uq (
+        .xm(node_clb[30:0]), .ym(ub[30:0]), .x_neg(u_neg), .y_neg(q_neg), .x_big(u_big), .y_big(q_big),
+        .x_ee(u_ee), .y_ee(q_ee), .x_d(u_d), .y_d(q_d), .close(uq_close), .lt(u_lt_q_unused), .gt(u_gt_q_unused));
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [W-1:0] dqk    = kq_lo - ku_lo;                  // kq - K when close(u, q): < 2^N?
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire         in_window = p_lt_u ? (pu_close & (k_lo == ku_lo) & fits) : (uq_close & ~|dqk[W-1:N]);
+
     // ---- status (section 10) ----------------------------------------------------
-    wire nan_inf   = p_nan | q_nan;
-    // p > q by value (-0 is zero, so its neg flag is clear): from the sign flags and
-    // the magnitude-pattern difference, which orders finite floats of one sign
-    wire pd_pos    = ~pdiff[31] & ~pd_zero;
-    wire inverted  = ~nan_inf & (same ? (p_neg ? pd_pos : pdiff[31]) : (~p_neg & q_neg));
+    wire nan_inf   = p_nan | q_nan | u_nan;
+    wire inverted  = ~nan_inf & p_gt_q;
     wire bad_scale = (e < EMIN10) || (e > 10'sd126);
     wire reject    = nan_inf | inverted | bad_scale | BAD_PARAM;
     // one reject bit: the first failing check in the order of section 10
@@ -145,8 +165,61 @@ module cbvh_axis_compressor #(
     assign child_scale = reject ? 8'd0 : cs;
     assign clb         = reject ? 32'd0 : u_val;
     assign cub         = reject ? 32'd0 : v_val;
-    assign status      = {~reject & ~fits, 2'b00, BAD_PARAM, st_scale, st_inv, st_nan};
+    assign status      = {~reject & ~in_window, ~reject & ~fits, 2'b00, BAD_PARAM, st_scale, st_inv, st_nan};
 
+endmodule
+
+// Two values x <= y (as values; both decomposed by cbvh_axis_compressor_bound):
+// their order, and "close": kq - k < 2^W for k = floor(x/2^e), kq = floor(y/2^e),
+// so that the difference of the W-bit windows is the true one; not close
+// implies kq - k >= 2^N.  (The order outputs hold for any x, y.)
+//   Neither bound big (|x| < 2^(e+W-1)): |k|, |kq| <= 2^(W-1), the difference is
+// below 2^W. A big bound and the other of opposite sign: difference
+// >= 2^(W-1) > 2^N. Same sign, magnitudes A <= B, B big: binades two or
+// more apart give B - A > B/2 >= 2^(e+W-2), difference >= 2^N. One
+// binade apart at most (both normal, as B big means B >= 2^-121; the -Inf
+// pattern, 2^128, is one more binade of the same pattern order): the
+// magnitude-pattern difference P = pat(B) - pat(A) has X/2 <= P <= X, X = B - A
+// in units of 2^expA. With T = N + e - expA, P <= 2^T holds when
+// kq - k <= 2^N - 1 and fails when kq - k >= 2^W, which is all "close" needs.
+module cbvh_axis_compressor_pair #(
+    parameter integer N = 6
+) (
+    input  wire [30:0]       xm,      // |x| and |y| as patterns (the signs are x_neg, y_neg)
+    input  wire [30:0]       ym,
+    input  wire              x_neg,
+    input  wire              y_neg,
+    input  wire              x_big,
+    input  wire              y_big,
+    input  wire [7:0]        x_ee,
+    input  wire [7:0]        y_ee,
+    input  wire signed [9:0] x_d,
+    input  wire signed [9:0] y_d,
+    output wire              close,
+    output wire              lt,      // x < y by value
+    output wire              gt       // x > y by value
+);
+    localparam signed [9:0] NS10 = N[9:0];
+    wire         same   = (x_neg == y_neg);
+    wire signed [9:0] a_d = x_neg ? y_d : x_d;            // e - expA
+    wire [8:0]   gq     = {1'b0, y_ee} - {1'b0, x_ee};
+    wire         gap_ok = (gq == 9'd0) || (gq == (x_neg ? 9'h1FF : 9'd1));
+    // pdiff = pat(y) - pat(x) (magnitudes); R = P for x, y >= 0, P - 1 for x, y < 0
+    // (a one's complement instead of a negation; P = 0 is caught separately)
+    wire [31:0]  pdiff  = {1'b0, ym} - {1'b0, xm};
+    wire [30:0]  r_x    = x_neg ? ~pdiff[30:0] : pdiff[30:0];
+    wire signed [9:0] t_x = a_d + NS10;                   // T
+    wire [4:0]   t_xc   = (t_x < 10'sd0) ? 5'd0 : (t_x > 10'sd31) ? 5'd31 : t_x[4:0];
+    wire [30:0]  x_low  = ~(31'h7FFFFFFF << t_xc);        // bits below 2^T
+    wire         pd_zero = ~|pdiff;                       // P = 0 (R would wrap)
+    // R < 2^T; for T < 0 only P = 0 passes (P - 1 < 2^T <=> P <= 2^T needs T >= 0)
+    wire         x_small = pd_zero | (~t_x[9] & ~|(r_x & ~x_low));
+    assign close = (~x_big & ~y_big) | (same & gap_ok & x_small);
+    // the order (-0 is zero, so its neg flag is clear): from the sign flags and the
+    // magnitude-pattern difference, which orders finite floats of one sign
+    wire         pd_pos = ~pdiff[31] & ~pd_zero;
+    assign gt = same ? (x_neg ? pd_pos : pdiff[31]) : (~x_neg & y_neg);
+    assign lt = same ? (x_neg ? pdiff[31] : pd_pos) : (x_neg & ~y_neg);
 endmodule
 
 // Decomposition and grid alignment of one bound x at scale e (section 3):

@@ -3,7 +3,7 @@
 //
 //   per axis a: context check as the decoder does it (BAD_SCALE, BAD_CODE, NAN_INF)
 //               p^ = (node_lb_mod << (parent_scale - scale)) mod 2^N  (0 if shift >= N)
-//   per non-empty child c, axis a: cbvh_axis_compressor(lo, hi, scale) -> r^, s^
+//   per non-empty child c, axis a: cbvh_axis_compressor(lo, hi, scale, node_clb) -> r^, s^
 //               modulo:   codes r^, s^
 //               relative: codes (r^ - p^) mod 2^N, (s^ - p^) mod 2^N  (= r, s mod 2^N)
 //   node: [2aN, +N) lower code, [2aN+N, +N) upper code, [6N] leaf,
@@ -12,8 +12,8 @@
 //         leaf flag and pointer inputs are ignored
 //   BAD_FORMAT: leaf pointer = 2^P - 1 (the empty marker) or a pointer >= 2^P
 //   status = the context checks' bits if any context is rejected; else the OR of the
-//         non-empty children's compressor statuses and BAD_FORMAT (NO_FIT included,
-//         also next to a reject); any reject bit zeroes every word (section 9).
+//         non-empty children's compressor statuses and BAD_FORMAT (NO_FIT and OUTSIDE
+//         included, also next to a reject); any reject bit zeroes every word (section 9).
 //
 // Flags input (one hex digit on the wire): bit 0 = leaf, bit 1 = empty child,
 // bits 3:2 unused (ignored, as the vectors show).
@@ -58,7 +58,7 @@ module cbvh_nodepair_encoder #(
     output wire [31:0] word3,
     output wire [31:0] word4,        // zero for N <= 6 (16-byte pair)
     output wire [31:0] word5,        // zero for N <= 6
-    output wire [7:0]  status        // datapath.md section 10; bit 7 always 0
+    output wire [7:0]  status        // datapath.md section 10
 );
 /* verilator lint_on DECLFILENAME */
 
@@ -99,7 +99,7 @@ module cbvh_nodepair_encoder #(
     wire [1:0] empty = {c1_flags[1], c0_flags[1]};
 
     wire [6*N-1:0] lo_code, hi_code;   // stored codes (zero for an empty child)
-    wire [6:0]     cst [0:5];          // compressor statuses, masked for empty children
+    wire [7:0]     cst [0:5];          // compressor statuses, masked for empty children
 
     genvar i;
     generate
@@ -107,7 +107,7 @@ module cbvh_nodepair_encoder #(
             localparam integer AX = i % 3;
             localparam integer CH = i / 3;
             wire [N-1:0] lm, um;
-            wire [6:0]   st;
+            wire [7:0]   st;
             // the encoder's words carry only the codes; the decoded box and the
             // child scale of unit 2 are not outputs of this unit
             /* verilator lint_off UNUSED */
@@ -116,7 +116,7 @@ module cbvh_nodepair_encoder #(
             /* verilator lint_on UNUSED */
             cbvh_axis_compressor #(.N(N), .E_MIN(E_MIN)) u_cmp (
                 .lb(box_all[64*i +: 32]), .ub(box_all[64*i+32 +: 32]),
-                .scale(sc_all[8*AX +: 8]), .lb_mod(lm), .ub_mod(um),
+                .scale(sc_all[8*AX +: 8]), .node_clb(clb_all[32*AX +: 32]), .lb_mod(lm), .ub_mod(um),
                 .child_scale(cs_unused), .clb(clb_unused), .cub(cub_unused),
                 .status(st));
             wire [N-1:0] ph = phat[N*AX +: N];
@@ -124,7 +124,7 @@ module cbvh_nodepair_encoder #(
             wire [N-1:0] hi = (MODULO != 0) ? um : (um - ph);
             assign lo_code[N*i +: N] = empty[CH] ? {N{1'b0}} : lo;
             assign hi_code[N*i +: N] = empty[CH] ? {N{1'b0}} : hi;
-            assign cst[i] = empty[CH] ? 7'd0 : st;
+            assign cst[i] = empty[CH] ? 8'd0 : st;
         end
     endgenerate
 
@@ -166,10 +166,10 @@ module cbvh_nodepair_encoder #(
     // ---- status and outputs --------------------------------------------------------
     // section 9: a rejected context ends the encode with the context bits alone;
     // otherwise the OR of the children's format checks and compressor statuses,
-    // NO_FIT included even when another bit rejects the pair
-    wire [6:0] ctx_st  = {1'b0, 1'b0, |ctx_code, BAD_PARAM, |ctx_scale, 1'b0, |ctx_nan};
-    wire [6:0] axis_st = cst[0] | cst[1] | cst[2] | cst[3] | cst[4] | cst[5];
-    wire [6:0] st_all  = (|ctx_st) ? ctx_st : (axis_st | {1'b0, |fmt_bad, 5'd0});
+    // NO_FIT and OUTSIDE included even when another bit rejects the pair
+    wire [7:0] ctx_st  = {2'b00, 1'b0, |ctx_code, BAD_PARAM, |ctx_scale, 1'b0, |ctx_nan};
+    wire [7:0] axis_st = cst[0] | cst[1] | cst[2] | cst[3] | cst[4] | cst[5];
+    wire [7:0] st_all  = (|ctx_st) ? ctx_st : (axis_st | {2'b00, |fmt_bad, 5'd0});
     wire       reject  = |st_all[5:0];
     wire [191:0] words;
     generate
@@ -186,6 +186,6 @@ module cbvh_nodepair_encoder #(
     assign word3  = words[127:96];
     assign word4  = words[159:128];
     assign word5  = words[191:160];
-    assign status = {1'b0, st_all};
+    assign status = st_all;
 
 endmodule

@@ -34,14 +34,14 @@ endmodule
 
 module fpga_top_axis_compressor #(parameter integer N = 6, parameter integer E_MIN = -30) (
     input wire clk, input wire din, input wire load, output wire dout);
-    localparam integer IN_W = 72, OUT_W = 2 * N + 8 + 64 + 7;
+    localparam integer IN_W = 104, OUT_W = 2 * N + 8 + 64 + 8;
     wire [IN_W-1:0] in_sr;
     wire [N-1:0] lb_mod, ub_mod;
     wire [7:0] child_scale;
     wire [31:0] clb, cub;
-    wire [6:0] status;
+    wire [7:0] status;
     cbvh_axis_compressor #(.N(N), .E_MIN(E_MIN)) unit (
-        .lb(in_sr[31:0]), .ub(in_sr[63:32]), .scale(in_sr[71:64]),
+        .lb(in_sr[31:0]), .ub(in_sr[63:32]), .scale(in_sr[71:64]), .node_clb(in_sr[103:72]),
         .lb_mod(lb_mod), .ub_mod(ub_mod), .child_scale(child_scale),
         .clb(clb), .cub(cub), .status(status));
     fpga_shift_io #(.IN_W(IN_W), .OUT_W(OUT_W)) io (.clk(clk), .din(din), .load(load),

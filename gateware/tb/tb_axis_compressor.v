@@ -6,47 +6,47 @@ module tb_axis_compressor;
     parameter integer N     = 6;
     parameter integer E_MIN = -30;
 
-    reg  [31:0]  lb, ub;
+    reg  [31:0]  lb, ub, node_clb;
     reg  [7:0]   scale;
     wire [N-1:0] lb_mod, ub_mod;
     wire [7:0]   child_scale;
     wire [31:0]  clb, cub;
-    wire [6:0]   status;
+    wire [7:0]   status;
 
     cbvh_axis_compressor #(.N(N), .E_MIN(E_MIN)) dut (
-        .lb(lb), .ub(ub), .scale(scale), .lb_mod(lb_mod), .ub_mod(ub_mod),
+        .lb(lb), .ub(ub), .scale(scale), .node_clb(node_clb), .lb_mod(lb_mod), .ub_mod(ub_mod),
         .child_scale(child_scale), .clb(clb), .cub(cub), .status(status));
 
     localparam [8*24-1:0] VF_TB = "tb_axis_compressor", VF_UNIT = "axis_compress";
     localparam integer VF_ENC = 0, VF_MODULO = 0;
     `include "vecfile.vh"
-    reg [31:0] i_lb, i_ub, x_clb, x_cub;
+    reg [31:0] i_lb, i_ub, i_node, x_clb, x_cub;
     reg [31:0] i_sc, x_lm, x_um, x_cs, x_st;
 
     initial begin
         vf_open;
 
-        // vectors: lb ub scale -> lb_mod ub_mod child_scale clb cub status
+        // vectors: lb ub scale node_clb -> lb_mod ub_mod child_scale clb cub status
         vf_read_line;
         while (vf_rc != 0) begin
-            // 9 hex fields, no more
-            {i_lb, i_ub, i_sc, x_lm, x_um, x_cs, x_clb, x_cub, x_st} =
-                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8]};
-            if (vf_nw != 9)
+            // 10 hex fields, no more
+            {i_lb, i_ub, i_sc, i_node, x_lm, x_um, x_cs, x_clb, x_cub, x_st} =
+                {vf_w[0], vf_w[1], vf_w[2], vf_w[3], vf_w[4], vf_w[5], vf_w[6], vf_w[7], vf_w[8], vf_w[9]};
+            if (vf_nw != 10)
                 $fatal(1, "tb_axis_compressor: %0s:%0d: malformed vector line", vf_path, vf_lineno);
-            lb = i_lb; ub = i_ub; scale = i_sc[7:0];
+            lb = i_lb; ub = i_ub; scale = i_sc[7:0]; node_clb = i_node;
             #1;
             vf_nvec = vf_nvec + 1;
             if (x_lm !== {{(32-N){1'b0}}, lb_mod} || x_um !== {{(32-N){1'b0}}, ub_mod} ||
                 x_cs !== {24'd0, child_scale} || clb !== x_clb || cub !== x_cub ||
-                x_st !== {25'd0, status}) begin
+                x_st !== {24'd0, status}) begin
                 vf_nfail = vf_nfail + 1;
                 if (vf_nfail <= 10)
-                    $display("mismatch line %0d: inputs lb=%08h ub=%08h scale=%02h expected %03h %03h %02h %08h %08h %02h got %03h %03h %02h %08h %08h %02h",
-                             vf_lineno, i_lb, i_ub, i_sc[7:0],
+                    $display("mismatch line %0d: inputs lb=%08h ub=%08h scale=%02h node_clb=%08h expected %03h %03h %02h %08h %08h %02h got %03h %03h %02h %08h %08h %02h",
+                             vf_lineno, i_lb, i_ub, i_sc[7:0], i_node,
                              x_lm[11:0], x_um[11:0], x_cs[7:0], x_clb, x_cub, x_st[7:0],
                              {{(12-N){1'b0}}, lb_mod}, {{(12-N){1'b0}}, ub_mod}, child_scale,
-                             clb, cub, {1'b0, status});
+                             clb, cub, status);
             end
             vf_read_line;
         end

@@ -55,12 +55,13 @@ int cbvh_vecgen_generate(const cbvh_vecgen_spec *s, cbvh_vecfile *vf) {
     uint64_t h = UINT64_C(0xCBF29CE484222325);
     for (const char *c = st; *c; c++) h = (h ^ (uint8_t)*c) * UINT64_C(0x100000001B3);
     rng_seed(&g.rng, s->seed ^ h);
+    g.stream = s->seed ^ h;
 
     const vg_unit *ug = find_gen(s->unit);
     if (!ug) return -1;
     ug->gen(&g, ug->level1);
     rng_t ex; /* generator 2: the exact-path cases, from a stream of their own */
-    rng_seed(&ex, s->seed ^ h ^ UINT64_C(0xE7AC7CA5E5000002));
+    rng_seed(&ex, g.stream ^ UINT64_C(0xE7AC7CA5E5000002));
     if (ug->exact) ug->exact(&g, &ex, ug->n_exact);
     if (ug->appended) ug->appended(&g);
     if (s->level >= 2) {

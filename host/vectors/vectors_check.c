@@ -202,18 +202,22 @@ static void locate_failure(const char *berr, const cbvh_vecfile *vf, size_t off,
 
 /* ---- reporting -------------------------------------------------------------- */
 
-static const char *const status_bit_names[] = {"NAN_INF", "INVERTED", "BAD_SCALE", "BAD_PARAM",
-                                               "BAD_CODE", "BAD_FORMAT", "NO_FIT"};
+static const char *const status_bit_names[] = {"NAN_INF",    "INVERTED", "BAD_SCALE", "BAD_PARAM",
+                                               "BAD_CODE",   "BAD_FORMAT", "NO_FIT",   "OUTSIDE"};
 
-/* Readable form of a field value: scales in decimal, status bits by name. */
-static void annotate(const char *name, uint32_t v, char *buf, size_t n) {
+/* Readable form of a field value: scales in decimal, status bits by name
+ * (bit 7 is the compressor's OUTSIDE and the ray units' ZERO_DIR). */
+static void annotate(const cbvh_unit *u, const char *name, uint32_t v, char *buf, size_t n) {
+    int ray_unit = strncmp(u->name, "ray_", 4) == 0;
     buf[0] = '\0';
     if (ends_with(name, "scale")) {
         snprintf(buf, n, " (%d)", cbvh_scale_from_word(v));
     } else if (strcmp(name, "status") == 0 && v) {
         size_t o = (size_t)snprintf(buf, n, " (");
-        for (int b = 0; b < 7 && o < n; b++)
-            if (v >> b & 1u) o += (size_t)snprintf(buf + o, n - o, "%s%s", o > 2 ? "|" : "", status_bit_names[b]);
+        for (int b = 0; b < 8 && o < n; b++)
+            if (v >> b & 1u)
+                o += (size_t)snprintf(buf + o, n - o, "%s%s", o > 2 ? "|" : "",
+                                      b == 7 && ray_unit ? "ZERO_DIR" : status_bit_names[b]);
         if (o < n) snprintf(buf + o, n - o, ")");
     }
 }
@@ -230,15 +234,15 @@ static void print_mismatch_text(FILE *f, const char *path, const cbvh_vecfile *v
     describe_cfg(vf, cfg, sizeof cfg);
     fprintf(f, "MISMATCH %s:%zu: %s (%s)\n  inputs:", path, vf->first_line + i, vf->unit->name, cfg);
     for (int k = 0; k < l->n_in; k++) {
-        annotate(l->in[k].name, in[k], note, sizeof note);
+        annotate(vf->unit, l->in[k].name, in[k], note, sizeof note);
         fprintf(f, " %s=%0*" PRIX32 "%s", l->in[k].name, l->in[k].hex_digits, in[k], note);
     }
     fprintf(f, "\n");
     for (int k = 0; k < l->n_out; k++) {
         int d = l->out[k].hex_digits;
         char ne[128];
-        annotate(l->out[k].name, exp[k], ne, sizeof ne);
-        annotate(l->out[k].name, act[k], note, sizeof note);
+        annotate(vf->unit, l->out[k].name, exp[k], ne, sizeof ne);
+        annotate(vf->unit, l->out[k].name, act[k], note, sizeof note);
         fprintf(f, "  %-18s expected %0*" PRIX32 "%s  actual %0*" PRIX32 "%s%s\n", l->out[k].name, d, exp[k], ne, d,
                 act[k], note, exp[k] != act[k] ? "   <-- differs" : "");
     }

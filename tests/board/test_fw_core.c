@@ -327,17 +327,20 @@ static void run_matches_model(void **s) {
     cbvh_unit_config cfg = {{6, -30}, CBVH_ENC_MODULO};
     cbvh_layout lay;
     u->layout(&cfg, &lay);
-    uint32_t in[4 * 3], want[4 * 8];
+    enum { NIN = 4 }; /* lb ub scale node_clb */
+    assert_int_equal(lay.n_in, NIN);
+    uint32_t in[4 * NIN], want[4 * 8];
     const float lb[4] = {0.f, -1.5f, 3.25f, 100.f}, ub[4] = {1.f, 2.f, 3.5f, 1e6f};
     for (int v = 0; v < 4; v++) {
-        memcpy(&in[3 * v], &lb[v], 4);
-        memcpy(&in[3 * v + 1], &ub[v], 4);
-        in[3 * v + 2] = cbvh_scale_to_word(-2 + v);
-        u->eval(&cfg, in + 3 * v, want + lay.n_out * v);
+        in[NIN * v] = cbvh_f32_of(lb[v]);
+        in[NIN * v + 1] = cbvh_f32_of(ub[v]);
+        in[NIN * v + 2] = cbvh_scale_to_word(-2 + v);
+        in[NIN * v + 3] = cbvh_f32_of(lb[v] - 1.0f); /* the node's lower bound */
+        u->eval(&cfg, in + NIN * v, want + lay.n_out * v);
     }
     uint8_t p[12 + sizeof in];
     run_header(p, u->id, 6, -30, 0, (uint8_t)lay.n_in, (uint8_t)lay.n_out, 4);
-    for (int i = 0; i < 12; i++) cbvh_put32(p + 12 + 4 * i, in[i]);
+    for (int i = 0; i < 4 * NIN; i++) cbvh_put32(p + 12 + 4 * i, in[i]);
     send_frame(CBVH_CMD_RUN, 77, p, sizeof p);
     cbvh_frame f = reply_at(0);
     assert_int_equal(f.status, CBVH_E_OK);

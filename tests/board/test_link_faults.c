@@ -98,7 +98,7 @@ static int scenario(const char *name, int kind, double rate, int batches, size_t
     cbvh_unit_config cfg = {{6, -30}, CBVH_ENC_MODULO};
     cbvh_layout lay;
     u->layout(&cfg, &lay);
-    uint32_t *in = malloc(per * 3 * 4), *want = malloc(per * 8 * 4), *got = malloc(per * 8 * 4);
+    uint32_t *in = malloc(per * (size_t)lay.n_in * 4), *want = malloc(per * 8 * 4), *got = malloc(per * 8 * 4);
     uint64_t rng = 777 + (uint64_t)kind;
     for (int i = 0; i < batches; i++) {
         cbvh_gen_inputs(&rng, &cfg, &lay, in, per);

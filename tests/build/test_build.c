@@ -926,7 +926,8 @@ static void test_compress_malformed(void **st) {
     const uint32_t c0 = b.nodes[b.root].child[0], g = b.nodes[c0].child[0];
     assert_false(cbvh_bvh_is_leaf(&b.nodes[c0]));
     const cbvh_bvh_node saved = b.nodes[g];
-    static const char *const status[3] = {"status 0x2)", "status 0x1)", "status 0x40)"};
+    /* NO_FIT implies OUTSIDE (0x80): a box wider than 2^N cells leaves the window */
+    static const char *const status[3] = {"status 0x2)", "status 0x1)", "status 0xc0)"};
     for (int m = 0; m < 3; m++)
         for (int enc = 0; enc < 2; enc++) {
             b.nodes[g] = saved;
@@ -1090,24 +1091,22 @@ static void test_reencode_rule(void **st) {
     for (int i = 0; i < 200000; i++) {
         float lo = (rndf() - 0.5f) * 64.0f, hi = lo + rndf() * 8.0f;
         if (i % 7 == 0) hi = lo; /* flat */
-        cbvh_f32 l, h;
-        memcpy(&l, &lo, 4);
-        memcpy(&h, &hi, 4);
+        cbvh_f32 l = cbvh_f32_of(lo), h = cbvh_f32_of(hi);
         int a;
         assert_int_equal(cbvh_scale_estimate(&p, l, h, &a), 0);
         int b = a + (int)(rnd() % 12);
         cbvh_axis_code qa, want, got, naive;
-        assert_int_equal(cbvh_axis_compress(&p, l, h, a, &qa), 0);
-        cbvh_axis_compress(&p, l, h, b, &want);
-        cbvh_axis_compress(&p, qa.clb, cbvh_f32_next_down(qa.cub), b, &got);
+        /* each box in its own window (node_clb = its lower bound, as a root) */
+        assert_int_equal(cbvh_axis_compress(&p, l, h, a, l, &qa), 0);
+        cbvh_axis_compress(&p, l, h, b, l, &want);
+        cbvh_axis_compress(&p, qa.clb, cbvh_f32_next_down(qa.cub), b, qa.clb, &got);
         assert_int_equal(got.lb_mod, want.lb_mod);
         assert_int_equal(got.ub_mod, want.ub_mod);
         assert_int_equal(got.clb, want.clb);
         assert_int_equal(got.cub, want.cub);
         assert_int_equal(got.child_scale, want.child_scale);
-        cbvh_axis_compress(&p, qa.clb, qa.cub, b, &naive);
-        float v;
-        memcpy(&v, &qa.cub, 4);
+        cbvh_axis_compress(&p, qa.clb, qa.cub, b, qa.clb, &naive);
+        float v = cbvh_float_of(qa.cub);
         int on_grid = fmod((double)v, ldexp(1.0, b)) == 0.0;
         assert_int_equal(naive.ub_mod != want.ub_mod || naive.cub != want.cub, on_grid);
         grew += on_grid;

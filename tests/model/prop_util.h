@@ -148,8 +148,22 @@ static inline uint32_t oracle_mod(double k, int n) {
     return (uint32_t)m;
 }
 
-/* The compressor's outputs, computed with the FPU. */
-static inline uint32_t oracle_compress(int n, int min_scale, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_axis_code *o) {
+/* The compressor's OUTSIDE (datapath.md §6) with the FPU: lb < g or
+ * ub >= g + 2^(N+e), g = floor(u / 2^e) 2^e, u = node_clb (-Inf: -2^128).
+ * g is exact in binary64; the sum is rounded up, and a binary32 ub is >= the
+ * sum iff it is >= its binary64 RU. */
+static inline int oracle_outside(int n, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node_clb) {
+    double u = node_clb == CBVH_F32_NEG_INF ? -0x1p128 : f32_as_double(node_clb);
+    double g = ldexp(floor(ldexp(u, -e)), e);
+    fesetround(FE_UPWARD);
+    volatile double top = g + ldexp(1.0, n + e);
+    fesetround(FE_TONEAREST);
+    return f32_as_double(lb) < g || f32_as_double(ub) >= top;
+}
+
+/* The compressor's outputs, computed with the FPU (inputs without faults). */
+static inline uint32_t oracle_compress(int n, int min_scale, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node_clb,
+                                       cbvh_axis_code *o) {
     double k = oracle_floor(lb, e), ku = oracle_floor(ub, e);
     double cells = ku - k + 1.0;
     int fit = cells <= ldexp(1.0, n);
@@ -162,7 +176,7 @@ static inline uint32_t oracle_compress(int n, int min_scale, cbvh_f32 lb, cbvh_f
     volatile double l = kd + one; /* rounded up in double, then up again: same as once */
     fesetround(FE_TONEAREST);
     o->cub = oracle_round_d(l, FE_UPWARD);
-    return fit ? 0 : CBVH_ST_NO_FIT;
+    return (fit ? 0 : CBVH_ST_NO_FIT) | (oracle_outside(n, lb, ub, e, node_clb) ? CBVH_ST_OUTSIDE : 0);
 }
 
 static inline int code_equal(const cbvh_axis_code *a, const cbvh_axis_code *b) {

@@ -19,13 +19,15 @@ static long n_checks;
 static const cbvh_params P6_30 = {6, CBVH_MIN_SCALE_DEFAULT};
 static const cbvh_params P6_126 = {6, CBVH_SCALE_FLOOR};
 
-/* Compress one box at scale e; compare with the FPU oracle and check
- * enclosure and the scale rules.  Returns the status. */
-static uint32_t compress_checked(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_axis_code *c) {
-    uint32_t st = cbvh_axis_compress(p, lb, ub, e, c);
+/* Compress one box at scale e in the window of the node whose lower bound
+ * is node_clb; compare with the FPU oracle and check enclosure and the
+ * scale rules.  Returns the status. */
+static uint32_t compress_checked_in(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node_clb,
+                                    cbvh_axis_code *c) {
+    uint32_t st = cbvh_axis_compress(p, lb, ub, e, node_clb, c);
     digest_code(&dg, st, c);
     cbvh_axis_code o;
-    uint32_t ost = oracle_compress(p->quant_bits, p->min_scale, lb, ub, e, &o);
+    uint32_t ost = oracle_compress(p->quant_bits, p->min_scale, lb, ub, e, node_clb, &o);
     CHECK(st == ost && code_equal(c, &o),
           "compress [%08x,%08x] e=%d N=%d ms=%d: model st=%#x " CODE_FMT ", oracle st=%#x " CODE_FMT, lb, ub, e,
           p->quant_bits, p->min_scale, st, CODE_ARGS(*c), ost, CODE_ARGS(o));
@@ -35,11 +37,20 @@ static uint32_t compress_checked(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub,
     return st;
 }
 
+/* The same in the window that starts at the box's own lowest cell
+ * (node_clb = lb, as for a root): OUTSIDE exactly with NO_FIT. */
+static uint32_t compress_checked(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_axis_code *c) {
+    uint32_t st = compress_checked_in(p, lb, ub, e, lb, c);
+    CHECK(!(st & CBVH_ST_OUTSIDE) == !(st & CBVH_ST_NO_FIT), "own window [%08x,%08x] e=%d: status %#x", lb, ub, e, st);
+    return st;
+}
+
 /* A child box inside its node, under ctx: must fit, and both decodes must
  * equal the compressor field by field. */
 static void child_checked(const cbvh_params *p, const cbvh_axis_ctx *ctx, cbvh_f32 lb, cbvh_f32 ub, cbvh_axis_code *c) {
-    uint32_t st = compress_checked(p, lb, ub, ctx->scale, c);
-    CHECK(st == 0, "child [%08x,%08x] at scale %d: status %#x (NO_FIT inside its node)", lb, ub, ctx->scale, st);
+    uint32_t st = compress_checked_in(p, lb, ub, ctx->scale, ctx->clb, c);
+    CHECK(st == 0, "child [%08x,%08x] at scale %d: status %#x (NO_FIT or OUTSIDE inside its node)", lb, ub, ctx->scale,
+          st);
     for (int enc = 0; enc < 2; enc++) {
         uint32_t lc, uc;
         cbvh_axis_code d;
@@ -165,7 +176,8 @@ static void cloth_node(const cbvh_params *p, cbvh_encoding enc, tri_box *t, int 
         for (int a = 0; a < 3; a++) {
             const cbvh_axis_code *code = &dout[c].axis[a];
             cbvh_axis_code o;
-            oracle_compress(p->quant_bits, p->min_scale, in[c].lo[a], in[c].hi[a], ctx->axis[a].scale, &o);
+            oracle_compress(p->quant_bits, p->min_scale, in[c].lo[a], in[c].hi[a], ctx->axis[a].scale, ctx->axis[a].clb,
+                            &o);
             CHECK(code_equal(code, &eo[c].axis[a]) && code_equal(code, &o), "cloth: decode/oracle mismatch axis %d", a);
             CHECK(encloses(code, in[c].lo[a], in[c].hi[a]), "cloth: no enclosure at depth %d axis %d", depth, a);
             if (code->child_scale < p->min_scale) s->below_min++;
@@ -436,7 +448,7 @@ static int case_min_scale_saturation(void) {
             /* scales below min_scale are rejected, outputs zero */
             cbvh_axis_code c, zero = {0, 0, 0, 0, 0};
             if (p.min_scale > CBVH_SCALE_FLOOR) {
-                uint32_t st = cbvh_axis_compress(&p, fb(1.0f), fb(2.0f), p.min_scale - 1, &c);
+                uint32_t st = cbvh_axis_compress(&p, fb(1.0f), fb(2.0f), p.min_scale - 1, 0, &c);
                 digest_code(&dg, st, &c);
                 CHECK(st == CBVH_ST_BAD_SCALE && code_equal(&c, &zero), "compress below min_scale: st %#x", st);
                 cbvh_axis_ctx bad = {p.min_scale, p.min_scale - 1, 0, 0};
@@ -538,7 +550,7 @@ static int case_nan_inf_rejected(void) {
                     digest_u32(&dg, st);
                     CHECK(st == CBVH_ST_NAN_INF && e == 0, "scale_estimate(%08x,%08x): st %#x e %d", lb, ub, st, e);
                     cbvh_axis_code c;
-                    st = cbvh_axis_compress(&p, lb, ub, 0, &c);
+                    st = cbvh_axis_compress(&p, lb, ub, 0, 0, &c);
                     digest_code(&dg, st, &c);
                     CHECK(st == CBVH_ST_NAN_INF && code_equal(&c, &zero), "compress(%08x,%08x): st %#x", lb, ub, st);
                     cbvh_axis_ctx ctx = {1, 2, 3, 4};

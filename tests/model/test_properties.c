@@ -92,15 +92,16 @@ static void prop_scale_estimate(prng *r, long iters) {
 }
 
 /* ---- unit 2: single-axis compressor ---- */
-static void check_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e) {
+static cbvh_f32 random_node_clb(prng *r, const cbvh_params *p, cbvh_f32 lb, int e);
+static void check_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node) {
     cbvh_axis_code c, o;
-    uint32_t st = cbvh_axis_compress(p, lb, ub, e, &c);
+    uint32_t st = cbvh_axis_compress(p, lb, ub, e, node, &c);
     digest_code(&dg, st, &c);
     n_cases++;
-    uint32_t ost = oracle_compress(p->quant_bits, p->min_scale, lb, ub, e, &o);
+    uint32_t ost = oracle_compress(p->quant_bits, p->min_scale, lb, ub, e, node, &o);
     if (st != ost || !code_equal(&c, &o)) {
-        prop_fail("compress [%08x,%08x] e=%d N=%d ms=%d: model st=%#x " CODE_FMT ", oracle st=%#x " CODE_FMT, lb, ub, e,
-                  p->quant_bits, p->min_scale, st, CODE_ARGS(c), ost, CODE_ARGS(o));
+        prop_fail("compress [%08x,%08x] e=%d node %08x N=%d ms=%d: model st=%#x " CODE_FMT ", oracle st=%#x " CODE_FMT,
+                  lb, ub, e, node, p->quant_bits, p->min_scale, st, CODE_ARGS(c), ost, CODE_ARGS(o));
         return;
     }
     if (!encloses(&c, lb, ub)) prop_fail("compress: no enclosure [%08x,%08x] e=%d -> [%08x,%08x]", lb, ub, e, c.clb, c.cub);
@@ -126,13 +127,33 @@ static void prop_compress(prng *r, long iters) {
             break;
         default: e = prng_range(r, p.min_scale, CBVH_SCALE_CEIL); break;
         }
-        check_compress(&p, lb, ub, e);
+        check_compress(&p, lb, ub, e, random_node_clb(r, &p, lb, e));
+    }
+}
+
+/* A node lower bound for a box [lb, ...] at scale e: the box's own (its
+ * window starts at its lowest cell), one j cells lower or higher (the
+ * window's ends around the box), off the grid, -Inf (-2^128), or any. */
+static cbvh_f32 random_node_clb(prng *r, const cbvh_params *p, cbvh_f32 lb, int e) {
+    double k = oracle_floor(lb, e);
+    switch (prng_below(r, 6)) {
+    case 0: return lb;
+    case 1: return prng_below(r, 4) ? prop_random_float(r) : CBVH_F32_NEG_INF;
+    case 2: /* a grid line j cells below: lb's window starts there */
+    case 3: {
+        double j = (double)prng_range(r, -2, (1 << p->quant_bits) + 2);
+        return oracle_round_d(ldexp(k - j, e), prng_below(r, 2) ? FE_DOWNWARD : FE_UPWARD);
+    }
+    default: { /* off the grid: within a cell near lb's */
+        double j = (double)prng_range(r, -2, 2), f = (double)(prng_next(r) >> 11) * 0x1p-53;
+        return oracle_round_d(ldexp(k - j + f, e), FE_DOWNWARD);
+    }
     }
 }
 
 /* ---- unit 3: decoder, (a) chains of nested boxes, (b) arbitrary contexts ---- */
 static void check_child(const cbvh_params *p, const cbvh_axis_ctx *ctx, cbvh_f32 lb, cbvh_f32 ub, cbvh_axis_code *c) {
-    uint32_t st = cbvh_axis_compress(p, lb, ub, ctx->scale, c);
+    uint32_t st = cbvh_axis_compress(p, lb, ub, ctx->scale, ctx->clb, c);
     digest_code(&dg, st, c);
     n_cases++;
     if (st) {
@@ -195,6 +216,117 @@ static void prop_decode_chains(prng *r, long iters) {
             ub = b;
         }
     }
+}
+
+/* ---- unit 2's window check, OUTSIDE (datapath.md §6) ----
+ * Node/child pairs: a node box and its context (the root context, or up to
+ * three levels down a chain of nested boxes); a child inside the node's box,
+ * at the ends of the node's window (first and last binary32 inside, first
+ * outside), across them, or anywhere.  Properties: the bit is set iff the
+ * child leaves the window (FPU oracle); a child inside its node's box never
+ * sets it (the builders' precondition); with the bit (and any reject) clear,
+ * both encodings decode to the compressor's outputs, which enclose the
+ * child. */
+static cbvh_f32 dn(cbvh_f32 x) { return x == (CBVH_F32_SIGN | CBVH_F32_MAX) ? x : cbvh_f32_next_down(x); }
+static cbvh_f32 upf(cbvh_f32 x) { return x == CBVH_F32_MAX ? x : cbvh_f32_next_up(x); }
+
+/* prop_point_in for x and y in either order */
+static cbvh_f32 point_between(prng *r, cbvh_f32 x, cbvh_f32 y) {
+    return cbvh_f32_key(x) <= cbvh_f32_key(y) ? prop_point_in(r, x, y) : prop_point_in(r, y, x);
+}
+
+static long window_counts[3]; /* children inside the node's box, flagged OUTSIDE, decoded */
+
+static void check_window_child(const cbvh_params *p, const cbvh_axis_ctx *ctx, cbvh_f32 a, cbvh_f32 b, int in_box) {
+    cbvh_axis_code c;
+    uint32_t st = cbvh_axis_compress(p, a, b, ctx->scale, ctx->clb, &c);
+    digest_code(&dg, st, &c);
+    n_cases++;
+    int want = oracle_outside(p->quant_bits, a, b, ctx->scale, ctx->clb);
+    if (st & CBVH_ST_REJECT) {
+        prop_fail("window: child [%08x,%08x] rejected: %#x", a, b, st);
+        return;
+    }
+    if (!(st & CBVH_ST_OUTSIDE) != !want)
+        prop_fail("window: child [%08x,%08x] scale %d node_clb %08x N=%d: OUTSIDE %d, oracle %d", a, b, ctx->scale,
+                  ctx->clb, p->quant_bits, !!(st & CBVH_ST_OUTSIDE), want);
+    window_counts[0] += in_box;
+    window_counts[1] += !!(st & CBVH_ST_OUTSIDE);
+    if (in_box && st) prop_fail("window: child [%08x,%08x] inside its node's box: status %#x", a, b, st);
+    if (st) return;
+    window_counts[2]++;
+    for (int enc = 0; enc < 2; enc++) {
+        uint32_t lc, uc;
+        cbvh_axis_code d;
+        cbvh_axis_store_codes(p, (cbvh_encoding)enc, ctx, &c, &lc, &uc);
+        uint32_t dst = cbvh_axis_decode(p, (cbvh_encoding)enc, ctx, lc, uc, &d);
+        digest_code(&dg, dst, &d);
+        if (dst || !code_equal(&d, &c) || !encloses(&d, a, b))
+            prop_fail("window: %s decode of [%08x,%08x] (ctx %d/%d/%u/%08x N=%d) st=%#x " CODE_FMT " vs " CODE_FMT,
+                      enc ? "relative" : "modulo", a, b, ctx->parent_scale, ctx->scale, ctx->lb_mod, ctx->clb,
+                      p->quant_bits, dst, CODE_ARGS(d), CODE_ARGS(c));
+    }
+}
+
+static void prop_compress_window(prng *r, long iters) {
+    for (long i = 0; i < iters; i++) {
+        cbvh_params p = random_params(r);
+        cbvh_f32 lo, hi;
+        random_box(r, i, &lo, &hi);
+        cbvh_axis_ctx ctx;
+        if (cbvh_axis_root_ctx(&p, lo, hi, &ctx)) {
+            prop_fail("window: root_ctx [%08x,%08x]", lo, hi);
+            continue;
+        }
+        for (int d = (int)prng_range(r, 0, 3); d > 0; d--) { /* down a chain of nested boxes */
+            cbvh_f32 x = prop_point_in(r, lo, hi), y = prop_point_in(r, lo, hi);
+            if (cbvh_f32_key(x) > cbvh_f32_key(y)) { cbvh_f32 t = x; x = y; y = t; }
+            cbvh_axis_code c;
+            cbvh_axis_compress(&p, x, y, ctx.scale, ctx.clb, &c);
+            ctx = cbvh_axis_child_ctx(&ctx, &c);
+            lo = x;
+            hi = y;
+        }
+        /* the window [g, top): its first binary32, its last, the first past it */
+        double g = ctx.clb == CBVH_F32_NEG_INF ? -0x1p128 : f32_as_double(ctx.clb);
+        fesetround(FE_UPWARD);
+        volatile double top = g + ldexp(1.0, p.quant_bits + ctx.scale);
+        fesetround(FE_TONEAREST);
+        cbvh_f32 first = ctx.clb == CBVH_F32_NEG_INF ? (CBVH_F32_SIGN | CBVH_F32_MAX) : ctx.clb;
+        cbvh_f32 past = oracle_round_d(top, FE_UPWARD), last = past == CBVH_F32_POS_INF ? CBVH_F32_MAX : dn(past);
+        if (past == CBVH_F32_POS_INF) past = CBVH_F32_MAX;
+        cbvh_f32 a, b;
+        int in_box = 0;
+        switch (prng_below(r, 6)) {
+        case 0:
+        case 1: /* inside the node's box */
+            a = prop_point_in(r, lo, hi), b = prop_point_in(r, lo, hi);
+            in_box = 1;
+            break;
+        case 2: { /* at the lower end: one below, on, one above the first */
+            cbvh_f32 e3[3] = {dn(first), first, upf(first)};
+            a = e3[prng_below(r, 3)];
+            b = point_between(r, a, prng_below(r, 2) ? last : past);
+            break;
+        }
+        case 3: { /* at the upper end: the last inside, the first past, one further */
+            cbvh_f32 e3[3] = {last, past, upf(past)};
+            b = e3[prng_below(r, 3)];
+            a = point_between(r, prng_below(r, 2) ? first : dn(first), b);
+            break;
+        }
+        case 4: /* anywhere near the window */
+            a = point_between(r, dn(dn(first)), upf(past)), b = point_between(r, dn(dn(first)), upf(past));
+            break;
+        default: random_box(r, i, &a, &b); break;
+        }
+        if (cbvh_f32_key(a) > cbvh_f32_key(b)) { cbvh_f32 t = a; a = b; b = t; }
+        check_window_child(&p, &ctx, a, b, in_box);
+    }
+    printf("  (window: %ld children inside their node's box, %ld flagged OUTSIDE, %ld decoded)\n", window_counts[0],
+           window_counts[1], window_counts[2]);
+    if (iters >= 1000 && (window_counts[1] < iters / 10 || window_counts[2] < iters / 3))
+        prop_fail("window: too few children outside (%ld) or decoded (%ld)", window_counts[1], window_counts[2]);
 }
 
 /* Decoder with arbitrary valid contexts and codes against the FPU. */
@@ -272,7 +404,7 @@ static void random_node_ctx(prng *r, const cbvh_params *p, cbvh_node_ctx *ctx, c
             cbvh_f32 x = prop_point_in(r, lo[a], hi[a]), y = prop_point_in(r, lo[a], hi[a]);
             if (cbvh_f32_key(x) > cbvh_f32_key(y)) { cbvh_f32 t = x; x = y; y = t; }
             cbvh_axis_code c;
-            cbvh_axis_compress(p, x, y, ctx->axis[a].scale, &c);
+            cbvh_axis_compress(p, x, y, ctx->axis[a].scale, ctx->axis[a].clb, &c);
             ctx->axis[a] = cbvh_axis_child_ctx(&ctx->axis[a], &c);
             lo[a] = x;
             hi[a] = y;
@@ -510,6 +642,7 @@ int main(int argc, char **argv) {
     } units[] = {
         {"scale_estimate", prop_scale_estimate, m},
         {"axis_compress", prop_compress, m},
+        {"axis_compress window (OUTSIDE) and decode", prop_compress_window, m},
         {"axis_decode chains (compress == modulo == relative)", prop_decode_chains, m},
         {"axis_decode vs FPU", prop_decode_random, m},
         {"nodepair round trip", prop_nodepair_roundtrip, m / 2},

@@ -96,8 +96,9 @@ static void check_box(int n, int ms, cbvh_f32 lb, cbvh_f32 ub, prng *r) {
         if (!hl && !hu && (cbvh_fast_floor_shift(ke, cs - e_unit) != kc || cbvh_fast_floor_shift(kue, cs - e_unit) != kuc))
             prop_fail("derived floors N=%d [%08x,%08x] e %d -> %d", n, lb, ub, e_unit, cs);
         cbvh_axis_code unit, orc;
-        uint32_t su = cbvh_axis_compress(&p, lb, ub, cs, &unit);
-        uint32_t so = oracle_compress(n, ms, lb, ub, cs, &orc);
+        cbvh_f32 node = prng_below(r, 2) ? lb : prop_random_float(r); /* its own window, or any */
+        uint32_t su = cbvh_axis_compress(&p, lb, ub, cs, node, &unit);
+        uint32_t so = oracle_compress(n, ms, lb, ub, cs, node, &orc);
         uint32_t lbm, ubm;
         int ccs;
         int fit = cbvh_fast_code(n, ms, cs, kc, kuc, &lbm, &ubm, &ccs);
@@ -252,6 +253,43 @@ static void check_naive(const cbvh_bvh *b, const cbvh_compress_opts *o0) {
         if (!rc[i]) cbvh_tree_free(&t[i]);
 }
 
+/* Not a BVH: a leaf child moved past its parent's box on one axis.  The
+ * compressor reports OUTSIDE for it (its codes would decode elsewhere), and
+ * both compressors refuse the tree with that status (0x80) instead of
+ * writing wrapped codes.  Real children never leave their node's window, so
+ * every other build here succeeding is the builders never seeing the bit. */
+static void check_not_a_bvh(const cbvh_bvh *b, int n) {
+    uint32_t x = 0;
+    while (x < b->nnodes && (cbvh_bvh_is_leaf(&b->nodes[x]) || !cbvh_bvh_is_leaf(&b->nodes[b->nodes[x].child[1]]))) x++;
+    if (x == b->nnodes) return;
+    for (int a = 0; a < 3; a++) {
+        cbvh_bvh c;
+        copy_bvh(b, &c);
+        const cbvh_bvh_node *nd = &c.nodes[x];
+        cbvh_bvh_node *leaf = &c.nodes[nd->child[1]];
+        double ext = 4.0 * ((double)nd->hi[a] - nd->lo[a]) + 1.0, v = nd->hi[a] + ext; /* past it, or below */
+        if (v > FLT_MAX) v = nd->lo[a] - ext;
+        if (v < -FLT_MAX) {
+            free(c.nodes);
+            continue;
+        }
+        leaf->lo[a] = leaf->hi[a] = (float)v;
+        cbvh_compress_opts o = {{n, CBVH_MIN_SCALE_DEFAULT}, CBVH_ENC_MODULO, 1, 0};
+        cbvh_tree t;
+        cbvh_bu_stats st;
+        char e[2][512];
+        int rt = cbvh_compress_topdown(&c, &o, &t, e[0], sizeof e[0]);
+        if (!rt) cbvh_tree_free(&t);
+        int rb = cbvh_compress_bottomup(&c, NULL, &o, &t, &st, e[1], sizeof e[1]);
+        if (!rb) cbvh_tree_free(&t);
+        n_cases++;
+        if (!rt || !rb || !strstr(e[0], "status 0x80") || !strstr(e[1], "status 0x80"))
+            prop_fail("a child outside its node (axis %d, N=%d): top-down %d '%s', bottom-up %d '%s'", a, n, rt,
+                      rt ? e[0] : "", rb, rb ? e[1] : "");
+        free(c.nodes);
+    }
+}
+
 static void stream_tests(prng *r, uint32_t nt) {
     static const int ms_list[] = {-126, -30, -10, 0};
     for (int kind = 0; kind < 3; kind++) {
@@ -272,6 +310,7 @@ static void stream_tests(prng *r, uint32_t nt) {
                 prop_fail("soup %d: build: %s", kind, errbuf);
                 continue;
             }
+            check_not_a_bvh(&b, CBVH_N_MIN + kind);
             for (int n = CBVH_N_MIN; n <= CBVH_N_MAX; n++)
                 for (int m = 0; m < 4; m++)
                     for (int enc = 0; enc < 2; enc++) {

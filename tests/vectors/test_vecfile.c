@@ -262,7 +262,7 @@ static void test_header_rules(void **state) {
         {"seed: 0x", "seed: 0y", CBVH_VEC_E_HEADER, "seed '0y"},
         {"level: 1\n", "level: 1\nencoding: modulo\n", CBVH_VEC_E_HEADER, "takes no 'encoding'"},
         {"---\n", "--\n", CBVH_VEC_E_HEADER, "malformed header line '--'"},
-        {"scale ->", "scale", CBVH_VEC_E_FIELDS, "found 'lb_mod', expected '->'"},
+        {"node_clb ->", "node_clb", CBVH_VEC_E_FIELDS, "found 'lb_mod', expected '->'"},
         {" status\n", "\n", CBVH_VEC_E_FIELDS, "fields header ends early: expected 'status'"},
         {" status\n", " status extra\n", CBVH_VEC_E_FIELDS, "extra names"},
         {"# cbvh golden vectors", "# cbvh golden vector", CBVH_VEC_E_MAGIC, "not a cbvh vector file"},
@@ -285,7 +285,7 @@ static void test_header_rules(void **state) {
     /* A vector beyond the count (appended); an empty line and a stray space
      * (inserted as the first vector line). */
     const char *extra[] = {"00000000 00000000 E2 000 000 E2 00000000 00000000 00\n", "\n", " \n"};
-    const char *want[] = {"more vectors than the header's count", "mem:12: empty line", "mem:12: 2 fields, expected 9"};
+    const char *want[] = {"more vectors than the header's count", "mem:12: empty line", "mem:12: 2 fields, expected 10"};
     size_t body = (size_t)(strstr(text, "---\n") - text) + 4;
     for (int i = 0; i < 3; i++) {
         size_t xl = strlen(extra[i]), at = i == 0 ? len : body;

@@ -25,7 +25,7 @@ static void decode_chain(gen_t *g, box_t root, int extras) {
     for (int depth = 0; depth < 2; depth++) {
         box_t child = vg_rnd_sub_box(&g->rng, node);
         cbvh_axis_code code;
-        if (cbvh_axis_compress(p, child.lo, child.hi, ctx.scale, &code) & CBVH_ST_REJECT) return;
+        if (cbvh_axis_compress(p, child.lo, child.hi, ctx.scale, ctx.clb, &code) & CBVH_ST_REJECT) return;
         uint32_t lc, uc;
         cbvh_axis_store_codes(p, enc, &ctx, &code, &lc, &uc);
         emit_decode(g, &ctx, lc, uc);

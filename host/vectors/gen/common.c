@@ -216,3 +216,24 @@ cbvh_f32 vg_nudge(rng_t *r, cbvh_f32 x) {
     default: return x;
     }
 }
+
+cbvh_f32 vg_add_cells(cbvh_f32 x, int64_t j, int e, cbvh_rnd mode) {
+    int sign, ex;
+    uint32_t sig;
+    if (x == CBVH_F32_NEG_INF) { /* -2^128 */
+        sign = 1, sig = CBVH_F32_HIDDEN, ex = 128 - CBVH_F32_FRAC_BITS;
+    } else {
+        cbvh_f32_break(x, &sign, &sig, &ex);
+    }
+    return cbvh_f32_add_dyadic(sign ? -(int64_t)sig : (int64_t)sig, ex, j, e, mode);
+}
+
+vg_window vg_window_of(const cbvh_axis_ctx *c, int n) {
+    vg_window w;
+    cbvh_f32 top = vg_add_cells(c->clb, (int64_t)1 << n, c->scale, CBVH_RND_UP); /* RU(u + 2^(N+e)) */
+    w.first = c->clb == CBVH_F32_NEG_INF ? (CBVH_F32_SIGN | CBVH_F32_MAX) : c->clb;
+    w.has_past = top != CBVH_F32_POS_INF;
+    w.past = w.has_past ? top : 0;
+    w.last = w.has_past ? down(top) : CBVH_F32_MAX;
+    return w;
+}

@@ -97,6 +97,7 @@ typedef struct {
     size_t n, cap;
     int oom;
     int random_only; /* level 2's extra part: random cases only */
+    uint64_t stream; /* the file's stream seed (seed ^ FNV-1a(stem)), for cases from streams of their own */
     int N;         /* quant_bits */
     int ms;        /* min_scale */
     uint32_t mask; /* 2^N - 1 */
@@ -124,6 +125,19 @@ extern const box_t vg_root_boxes[N_ROOT];
 #define N_RB_ORIG 8
 #define N_RB_DIR 8
 extern const cbvh_f32 vg_ray_orig[N_RB_ORIG], vg_ray_dir[N_RB_DIR];
+
+/* x + j 2^e rounded in direction mode, for a finite x or -Inf (-2^128):
+ * integer-only, through the model's exact sum. */
+cbvh_f32 vg_add_cells(cbvh_f32 x, int64_t j, int e, cbvh_rnd mode);
+
+/* A node context's window at its child scale (datapath.md §6): its first and
+ * last binary32 and the first past it (has_past 0: the window reaches past
+ * FLT_MAX). */
+typedef struct {
+    cbvh_f32 first, last, past;
+    int has_past;
+} vg_window;
+vg_window vg_window_of(const cbvh_axis_ctx *c, int n);
 
 /* Exact-path helpers (see vg_unit.exact): a random odd integer with exactly
  * `bits` bits (bits >= 2); a random normal float of either sign with

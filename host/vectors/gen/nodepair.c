@@ -283,6 +283,9 @@ static void np_children(gen_t *g, int variant, child_t ch[2]) {
     }
 }
 
+static void emit_pair(gen_t *g, const node_t *nd, const child_t ch[2], int decode);
+static void outside_pairs(gen_t *g, int decode);
+
 static void reject_combinations_nodepair(gen_t *g, int decode) {
     const cbvh_unit *enc_unit = cbvh_unit_find("nodepair_encode");
     int nw = (int)cbvh_nodepair_bytes(g->N) / 4;
@@ -333,14 +336,63 @@ static void reject_combinations_nodepair(gen_t *g, int decode) {
         }
         ch[0].flags = 0, ch[0].ptr = 5; /* inner */
         ch[1].flags = 1, ch[1].ptr = 9; /* leaf */
-        if (!decode) {
-            emit_encode(g, &nd, ch);
-            continue;
+        emit_pair(g, &nd, ch, decode);
+    }
+    outside_pairs(g, decode);
+}
+
+/* The pair's encoder vector, or (decode) the decoder's with the encoder's
+ * words for it under the same context. */
+static void emit_pair(gen_t *g, const node_t *nd, const child_t ch[2], int decode) {
+    if (!decode) {
+        emit_encode(g, nd, ch);
+        return;
+    }
+    uint32_t in[28], out[8];
+    encode_inputs(nd, ch, in);
+    cbvh_unit_find("nodepair_encode")->eval(&g->spec->cfg, in, out);
+    emit_decode_pair(g, &nd->ctx, out, (int)cbvh_nodepair_bytes(g->N) / 4);
+}
+
+/* Generator 9: children that leave their node's window on one axis
+ * (OUTSIDE, datapath.md §6, §9).  Per structured node (a root context per
+ * axis): both children inside; one ending on the window's last binary32
+ * (inside) and the other one past it; a child starting one ulp below the
+ * window; children outside on two axes; an empty child whose ignored box
+ * lies outside.  The encoder reports OUTSIDE and still writes the pair (not
+ * a reject); the decoder gets those words and cannot tell. */
+static void outside_pairs(gen_t *g, int decode) {
+    for (int i = 0; i < 6; i++) {
+        node_t nd;
+        if (make_node(g, &nd, i) != 0) continue;
+        vg_window w[3];
+        for (int a = 0; a < 3; a++) w[a] = vg_window_of(&nd.ctx.axis[a], g->N);
+        int ax = i % 3, ay = (i + 1) % 3;
+        for (int v = 0; v < 5; v++) {
+            child_t ch[2];
+            for (int c = 0; c < 2; c++) {
+                for (int a = 0; a < 3; a++) ch[c].b[a] = nd.axis[a];
+                ch[c].flags = (uint32_t)c; /* inner, leaf */
+                ch[c].ptr = 3u + (uint32_t)c;
+            }
+            switch (v) {
+            case 0: break; /* inside */
+            case 1:        /* touching the window's end from inside; one past it */
+                ch[0].b[ax].hi = w[ax].last;
+                ch[1].b[ax].hi = w[ax].has_past ? w[ax].past : w[ax].last;
+                break;
+            case 2: ch[0].b[ay].lo = down(w[ay].first); break; /* one ulp below the window */
+            case 3:                                              /* outside on two axes */
+                ch[0].b[ax].lo = down(w[ax].first);
+                ch[1].b[ay] = (box_t){w[ay].last, w[ay].has_past ? up(w[ay].past) : w[ay].last};
+                break;
+            default: /* an empty child: its box (outside) is ignored */
+                ch[1].flags = 2;
+                ch[1].b[ax].lo = down(w[ax].first);
+                break;
+            }
+            emit_pair(g, &nd, ch, decode);
         }
-        uint32_t in[28], out[8];
-        encode_inputs(&nd, ch, in);
-        enc_unit->eval(&g->spec->cfg, in, out);
-        emit_decode_pair(g, &nd.ctx, out, nw);
     }
 }
 

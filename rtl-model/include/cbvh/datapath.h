@@ -47,6 +47,8 @@ enum {
     CBVH_ST_BAD_CODE = 1u << 4,     /* a stored coordinate is >= 2^N */
     CBVH_ST_BAD_FORMAT = 1u << 5,   /* node pair: reserved bits set, malformed empty marker, pointer too wide */
     CBVH_ST_NO_FIT = 1u << 6,       /* compressor: box spans more than 2^N cells at this scale (not a reject) */
+    CBVH_ST_OUTSIDE = 1u << 7,      /* compressor: box leaves its node's window of 2^N cells (not a reject);
+                                     * the ray units use bit 7 for CBVH_ST_ZERO_DIR (traversal_units.h) */
 };
 #define CBVH_ST_REJECT (CBVH_ST_NAN_INF | CBVH_ST_INVERTED | CBVH_ST_BAD_SCALE | CBVH_ST_BAD_PARAM | CBVH_ST_BAD_CODE)
 
@@ -77,7 +79,14 @@ typedef struct {
     cbvh_f32 clb;     /* node decoded lower bound u; -Inf encodes -2^128 */
 } cbvh_axis_ctx;
 
-uint32_t cbvh_axis_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int scale, cbvh_axis_code *out);
+/* Compresses [lb, ub] on the grid 2^scale of the node whose decoded lower
+ * bound is node_clb (its context's clb; -Inf = -2^128).  Status CBVH_ST_OUTSIDE
+ * when the box leaves the node's window [g, g + 2^(N+scale)),
+ * g = floor(node_clb / 2^scale) 2^scale: its codes would not decode to an
+ * enclosing box under that node (docs/datapath.md §6).  A root, the only
+ * child of a virtual node, passes its own lb. */
+uint32_t cbvh_axis_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int scale, cbvh_f32 node_clb,
+                            cbvh_axis_code *out);
 
 uint32_t cbvh_axis_decode(const cbvh_params *p, cbvh_encoding enc, const cbvh_axis_ctx *ctx, uint32_t lb_code,
                           uint32_t ub_code, cbvh_axis_code *out);

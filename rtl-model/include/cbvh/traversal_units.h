@@ -4,7 +4,8 @@
  *   ray_box.c        low-precision ray-box test on the decoded grid (Eq. 4/5)
  *   ray_triangle.c   watertight ray-triangle test (Woop, Benthin, Wald 2013)
  * Ports are binary32 bit patterns (cbvh_f32); status bits are those of
- * datapath.h plus CBVH_ST_ZERO_DIR below. */
+ * datapath.h, with bit 7 CBVH_ST_ZERO_DIR below (the compressor's bit 7,
+ * OUTSIDE, no ray unit sets). */
 #ifndef CBVH_TRAVERSAL_UNITS_H
 #define CBVH_TRAVERSAL_UNITS_H
 

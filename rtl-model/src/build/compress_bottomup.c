@@ -89,12 +89,17 @@ typedef struct {
     size_t errlen;
 } bu_state;
 
-#define ENC_FAIL (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT | CBVH_ST_NO_FIT)
+/* What the encoder must not report for a pair the stream keeps: a reject, or
+ * a child that does not fit its node's grid or leaves its window (OUTSIDE:
+ * real BVH children never do; the exact rules keep them inside, and a naive
+ * re-encode that grows one past its node is repaired below). */
+#define ENC_FAIL (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT | CBVH_ST_NO_FIT | CBVH_ST_OUTSIDE)
 
 /* naive_reencode only: 1 if the pair decodes under ctx to exactly `want`.
- * The encoder does not check that children lie inside the node's box (the
- * decoder's window of 2^N cells); exact re-encoding keeps them inside, a
- * naive one may not, and then the codes wrap. */
+ * Exact re-encoding keeps children inside their node's box (the decoder's
+ * window of 2^N cells); a naive one may not, and then the codes wrap.  The
+ * encoder reports that (OUTSIDE, in ENC_FAIL); this is the decoder's side of
+ * it, a guard. */
 static int decodes_as(const bu_state *s, const cbvh_node_ctx *ctx, const uint8_t *bytes, uint32_t want_st,
                       const cbvh_child_out want[2]) {
     cbvh_child_out got[2];
@@ -153,8 +158,9 @@ static int backtrack(bu_state *s, uint32_t pair, const cbvh_node_ctx *old_ctx, c
         st = cbvh_nodepair_encode(p, s->o->enc, &it.new_ctx, in, bytes, nd);
         if (s->o->naive_reencode && !(st & ENC_FAIL)) {
             /* A grown child that touched its node's upper bound can land one
-             * cell past the node's box: its codes wrap.  Detect it with the
-             * decoder (what traversal would see) and fall back. */
+             * cell past the node's box: its codes wrap.  The encoder reports
+             * it (OUTSIDE); the decoder (what traversal would see) checks it
+             * again, and either falls back. */
             if (!decodes_as(s, &it.new_ctx, bytes, st, nd)) st |= CBVH_ST_NO_FIT;
         }
         /* ... or could not encode at all: a bound decoded as +Inf (2^128)
@@ -283,15 +289,26 @@ static inline uint32_t est_axis(const cbvh_params *p, int n, int ms, cbvh_f32 lb
     return cbvh_fast_code(n, ms, e, ax->k, ax->ku, &ax->lb_mod, &ub_mod, &ax->cs) ? 0 : CBVH_ST_NO_FIT;
 }
 
+/* The node's side of the fast path, per axis: its child grid cs, its lower
+ * bound's code at cs (relative encoding) and its record. */
+typedef struct {
+    int cs[3];
+    uint32_t pm[3];
+    const bu_axis *ax;
+} bu_node;
+
 /* One axis of a child through the compressor unit itself: codes (with the
  * relative offset pm removed) and child scale.  0 or a status. */
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
-static uint32_t axis_unit(const cbvh_params *p, const cbvh_bvh_node *cn, int a, int cs, uint32_t pm, uint64_t *w,
+static uint32_t axis_unit(const cbvh_params *p, const cbvh_bvh_node *cn, int a, const bu_node *nd, uint64_t *w,
                           int *child_scale) {
     cbvh_axis_code code;
-    uint32_t st = cbvh_axis_compress(p, cbvh_f32_of(cn->lo[a]), cbvh_f32_of(cn->hi[a]), cs, &code);
+    int cs = nd->cs[a];
+    uint32_t pm = nd->pm[a];
+    uint32_t st =
+        cbvh_axis_compress(p, cbvh_f32_of(cn->lo[a]), cbvh_f32_of(cn->hi[a]), cs, axis_clb(&nd->ax[a]), &code);
     int n = p->quant_bits;
     uint32_t mask = (1u << n) - 1u;
     *w |= (uint64_t)((code.lb_mod - pm) & mask) << (2 * a * n) | (uint64_t)((code.ub_mod - pm) & mask)
@@ -300,23 +317,36 @@ static uint32_t axis_unit(const cbvh_params *p, const cbvh_bvh_node *cn, int a, 
     return st;
 }
 
+/* Nonzero unless the child's box lies inside its node's box (NaN too).  The
+ * fast path takes only such children: they lie in the window of the node's
+ * context, which is estimated from that box (datapath.md §6), so the
+ * compressor would not report OUTSIDE.  Any other child goes to the general
+ * path, where the units decide (a tree whose child leaves its node's window
+ * is refused there). */
+static inline int outside_box(const cbvh_bvh_node *n, const cbvh_bvh_node *cn) {
+    int out = 0;
+    for (int a = 0; a < 3; a++) out |= !(cn->lo[a] >= n->lo[a]) | !(cn->hi[a] <= n->hi[a]);
+    return out;
+}
+
 /* The code bits [0, 6N) of a leaf child at the parent's scales cs: its box
  * floored directly.  0, or nonzero: the box does not fit (general path). */
-static inline int leaf_codes(const cbvh_params *p, int n, const cbvh_bvh_node *cn, const int cs[3],
-                             const uint32_t pm[3], uint64_t *w) {
+static inline int leaf_codes(const cbvh_params *p, int n, const cbvh_bvh_node *cn, const bu_node *nd, uint64_t *w) {
     int bad = 0;
     uint32_t mask = (1u << n) - 1u;
     uint64_t acc = 0;
     for (int a = 0; a < 3; a++) {
         int64_t k, ku;
-        if (!(cbvh_fast_floor(cbvh_f32_of(cn->lo[a]), cs[a], &k) & cbvh_fast_floor(cbvh_f32_of(cn->hi[a]), cs[a], &ku))) {
+        int cs = nd->cs[a];
+        uint32_t pm = nd->pm[a];
+        if (!(cbvh_fast_floor(cbvh_f32_of(cn->lo[a]), cs, &k) & cbvh_fast_floor(cbvh_f32_of(cn->hi[a]), cs, &ku))) {
             int unused;
-            bad |= axis_unit(p, cn, a, cs[a], pm[a], &acc, &unused) != 0;
+            bad |= axis_unit(p, cn, a, nd, &acc, &unused) != 0;
             continue;
         }
         bad |= (uint64_t)(ku - k) >= (UINT64_C(1) << n); /* cells = ku + 1 - k in 1..2^N */
-        acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm[a]) & mask) << (2 * a * n) |
-               (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm[a]) & mask) << (2 * a * n + n);
+        acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm) & mask) << (2 * a * n) |
+               (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm) & mask) << (2 * a * n + n);
     }
     *w = acc;
     return bad;
@@ -327,29 +357,31 @@ static inline int leaf_codes(const cbvh_params *p, int n, const cbvh_bvh_node *c
  * estimate (modulo: a child scale changed, exactly; relative: also a lower
  * bound that can have moved); the caller decides with the units. */
 static inline int inner_codes(const cbvh_params *p, int n, int ms, const bu_rec *r, const cbvh_bvh_node *cn,
-                              const int cs[3], const uint32_t pm[3], int rel, uint64_t *w, int *maybe) {
+                              const bu_node *nd, int rel, uint64_t *w, int *maybe) {
     int bad = 0, dif = 0;
     uint32_t mask = (1u << n) - 1u;
     uint64_t acc = 0;
     for (int a = 0; a < 3; a++) {
         const bu_axis *ra = &r->ax[a];
-        int d = cs[a] - ra->e, ccs;
+        int cs = nd->cs[a];
+        uint32_t pm = nd->pm[a];
+        int d = cs - ra->e, ccs;
         if (!ra->exact || d < 0) {
-            bad |= axis_unit(p, cn, a, cs[a], pm[a], &acc, &ccs) != 0;
+            bad |= axis_unit(p, cn, a, nd, &acc, &ccs) != 0;
             dif |= ccs != ra->cs || rel;
             continue;
         }
         int64_t k = cbvh_fast_floor_shift(ra->k, d), ku = cbvh_fast_floor_shift(ra->ku, d);
         uint64_t cells = (uint64_t)(ku + 1 - k);
         bad |= cells - 1u >= (UINT64_C(1) << n);
-        ccs = cs[a] - n + cbvh_grid_bitlen(cells - 1u);
+        ccs = cs - n + cbvh_grid_bitlen(cells - 1u);
         ccs = ccs < ms ? ms : ccs;
         dif |= ccs != ra->cs;
         /* relative: u = RD(k 2^cs) equals the estimate's RD(k_e 2^e) when
          * k_e is a multiple of 2^d (the same value); otherwise check */
         if (rel && d) dif |= d > 62 ? ra->k != 0 : ((uint64_t)ra->k & ((UINT64_C(1) << d) - 1u)) != 0;
-        acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm[a]) & mask) << (2 * a * n) |
-               (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm[a]) & mask) << (2 * a * n + n);
+        acc |= (uint64_t)(((uint32_t)(uint64_t)k - pm) & mask) << (2 * a * n) |
+               (uint64_t)(((uint32_t)(uint64_t)(ku + 1) - pm) & mask) << (2 * a * n + n);
     }
     *w = acc;
     *maybe = dif;
@@ -411,22 +443,22 @@ static inline int bu_step(cbvh_bu_stream *bs, const cbvh_bvh_node *n, const cbvh
         if (inner_children > sp) goto general; /* not a tree; the general path reports it */
         if (!cleaf[1]) cr[1] = &recs[sp - 1];
         if (!cleaf[0]) cr[0] = &recs[sp - 1 - !cleaf[1]];
-        int bad = 0;
+        int bad = outside_box(n, cn[0]) | outside_box(n, cn[1]);
         for (int a = 0; a < 3; a++)
             bad |= est_axis(p, nq, msc, cbvh_f32_of(n->lo[a]), cbvh_f32_of(n->hi[a]), &rx.ax[a]) != 0;
         if (bad) goto general;
-        int cs[3];
-        uint32_t pm[3] = {0, 0, 0}; /* relative: the node's lower bound at cs */
+        bu_node nd = {{0, 0, 0}, {0, 0, 0}, rx.ax};
+        const int *cs = nd.cs;
         for (int a = 0; a < 3; a++) {
-            cs[a] = rx.ax[a].cs;
+            nd.cs[a] = rx.ax[a].cs;
             int shift = rx.ax[a].e - cs[a];
-            if (rel) pm[a] = shift >= nq ? 0 : (rx.ax[a].lb_mod << shift) & qmask;
+            if (rel) nd.pm[a] = shift >= nq ? 0 : (rx.ax[a].lb_mod << shift) & qmask; /* relative: u's code at cs */
         }
         uint64_t w[2];
         int maybe[2] = {0, 0};
         for (int c = 0; c < 2; c++) /* one branch per child, not per axis */
-            bad |= cleaf[c] ? leaf_codes(p, nq, cn[c], cs, pm, &w[c])
-                            : inner_codes(p, nq, msc, cr[c], cn[c], cs, pm, rel, &w[c], &maybe[c]);
+            bad |= cleaf[c] ? leaf_codes(p, nq, cn[c], &nd, &w[c])
+                            : inner_codes(p, nq, msc, cr[c], cn[c], &nd, rel, &w[c], &maybe[c]);
         if (bad) goto general;
         for (int c = 0; c < 2; c++) cbvh_fast_put_node(nq, w[c], cleaf[c], slot[c], bytes + (size_t)c * nbytes);
         stats->encodes++;
@@ -438,8 +470,11 @@ static inline int bu_step(cbvh_bu_stream *bs, const cbvh_bvh_node *n, const cbvh
             cbvh_f32 cub[3];
             rec_ctx(cr[c], &stored);
             for (int a = 0; a < 3; a++) {
+                /* the child lies in the node's box (outside_box), hence in its
+                 * window: its own lower bound as node_clb spares forming u */
                 cbvh_axis_code code;
-                cbvh_axis_compress(p, cbvh_f32_of(cn[c]->lo[a]), cbvh_f32_of(cn[c]->hi[a]), cs[a], &code);
+                cbvh_f32 lo = cbvh_f32_of(cn[c]->lo[a]);
+                cbvh_axis_compress(p, lo, cbvh_f32_of(cn[c]->hi[a]), cs[a], lo, &code);
                 actual.axis[a] = cbvh_axis_child_ctx(&(cbvh_axis_ctx){rx.ax[a].e, cs[a], rx.ax[a].lb_mod, 0}, &code);
                 cub[a] = code.cub;
             }
@@ -470,7 +505,9 @@ general:;
             return -1;
         }
     }
-    st |= cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
+    /* a node box without a context (a reject above) is reported as such: its
+     * children's statuses under a zeroed context would mean nothing */
+    if (!st) st = cbvh_nodepair_encode(p, o->enc, &est, in, bytes, co);
     if (st & ENC_FAIL) {
         snprintf(s->err, s->errlen, "cbvh bottom-up: pair %u rejected by the encoder (status 0x%x)", pair, st);
         return -1;

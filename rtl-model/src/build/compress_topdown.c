@@ -33,7 +33,9 @@ int cbvh_compress_topdown(const cbvh_bvh *b, const cbvh_compress_opts *o, cbvh_t
         cbvh_pair_inputs(b, &l, it.node, in);
         uint32_t pair = cbvh_bvh_is_leaf(&b->nodes[it.node]) ? out->root_pair : l.slot[it.node];
         uint32_t st = cbvh_nodepair_encode(&o->params, o->enc, &it.ctx, in, out->pairs + (size_t)pair * out->pair_bytes, co);
-        if (st & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT | CBVH_ST_NO_FIT)) {
+        /* OUTSIDE: a child leaves its node's window, i.e. not inside its
+         * parent's box (not a BVH); real children never do */
+        if (st & (CBVH_ST_REJECT | CBVH_ST_BAD_FORMAT | CBVH_ST_NO_FIT | CBVH_ST_OUTSIDE)) {
             snprintf(err, errlen, "cbvh top-down: pair %u rejected by the encoder (status 0x%x)", pair, st);
             rc = -1;
             break;

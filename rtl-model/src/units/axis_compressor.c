@@ -5,7 +5,9 @@
  *   l = floor(ub / 2^e) + 1        negative, sign-magnitude inputs)
  *   lb_mod = k mod 2^N, ub_mod = l mod 2^N            (Eq. 8)
  *   child_scale = Eq. 2 of the (l - k)-cell box, clamped to min_scale
- *   clb = RD(k * 2^e), cub = RU(l * 2^e)      (exact grid values, rounded once) */
+ *   clb = RD(k * 2^e), cub = RU(l * 2^e)      (exact grid values, rounded once)
+ *   OUTSIDE: k < K or l > K + 2^N, K = floor(node_clb / 2^e): the box leaves
+ *            the node's window of 2^N cells, so its codes would not decode to it */
 #include "cbvh/datapath.h"
 #include "units/grid.h"
 #include "fast/unit_fast.h"
@@ -17,11 +19,13 @@ static const cbvh_axis_code zero_code;
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
-static uint32_t compress_general(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_axis_code *out) {
+static uint32_t compress_general(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node_clb,
+                                 cbvh_axis_code *out) {
     *out = zero_code;
     uint32_t st = cbvh_grid_params_check(p);
     if (st) return st;
-    if (cbvh_f32_is_nan_or_inf(lb) || cbvh_f32_is_nan_or_inf(ub)) return CBVH_ST_NAN_INF;
+    if (cbvh_f32_is_nan_or_inf(lb) || cbvh_f32_is_nan_or_inf(ub) || cbvh_grid_clb_bad(node_clb))
+        return CBVH_ST_NAN_INF;
     if (e < p->min_scale || e > CBVH_SCALE_CEIL) return CBVH_ST_BAD_SCALE;
     if (cbvh_f32_key(lb) > cbvh_f32_key(ub)) return CBVH_ST_INVERTED;
 
@@ -47,34 +51,47 @@ static uint32_t compress_general(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub,
     out->child_scale = fit ? cbvh_grid_child_scale(p, e, cells) : e;
 
     /* clb: k*2^e is lb itself when huge, else an exact small product. */
-    out->clb = huge_l ? (cbvh_f32_is_zero(lb) ? 0u : lb) : cbvh_grid_pack_signed(k, e, CBVH_RND_DOWN);
+    out->clb = cbvh_grid_below(lb, e);
+    int s, x;
+    uint32_t m;
     if (huge_u) {
-        int s, x;
-        uint32_t m;
         cbvh_grid_break(ub, &s, &m, &x);
         out->cub = cbvh_grid_add_dyadic(s ? -(int64_t)m : (int64_t)m, x, 1, e, CBVH_RND_UP);
     } else {
         out->cub = cbvh_grid_pack_signed(ku + 1, e, CBVH_RND_UP);
     }
-    return fit ? 0 : CBVH_ST_NO_FIT;
+
+    /* The node's window, exactly and for every input, huge ones included:
+     * with g = K 2^e (cbvh_grid_below), k < K iff lb < g, and l > K + 2^N iff
+     * ub >= g + 2^(N+e), iff ub >= RU(g + 2^(N+e)) (ub is a binary32 value;
+     * +Inf when the sum passes FLT_MAX, which no finite ub reaches). */
+    cbvh_f32 g = cbvh_grid_below(node_clb, e);
+    cbvh_grid_break(g, &s, &m, &x); /* -Inf breaks as -2^128 */
+    cbvh_f32 top = cbvh_grid_add_dyadic(s ? -(int64_t)m : (int64_t)m, x, 1, p->quant_bits + e, CBVH_RND_UP);
+    int outside = cbvh_f32_key(lb) < cbvh_f32_key(g) || cbvh_f32_key(ub) >= cbvh_f32_key(top);
+    return (fit ? 0 : CBVH_ST_NO_FIT) | (outside ? CBVH_ST_OUTSIDE : 0);
 }
 
 /* Fast path for the common case: valid parameters and scale, lb <= ub, both
  * bounds normal numbers whose grid step 2^e lies inside their significand
- * (cbvh_fast_in_sig: d = e - lsb exponent in [1, 23]).  The grid
- * coordinates k = floor(lb / 2^e), ku = floor(ub / 2^e) are unit_fast.h's
- * cbvh_fast_floor_in_sig and the codes and Eq. 2 child scale its
- * cbvh_fast_code: the same inline steps the streaming compressor runs, so
- * each has one definition.  Then 0 < |k|, |ku| < 2^24, and:
+ * (cbvh_fast_in_sig: d = e - lsb exponent in [1, 23]), and node_clb a value
+ * whose grid coordinate K = floor(node_clb / 2^e) is kept (cbvh_fast_floor:
+ * not "huge"; -Inf is -2^128).  The grid coordinates are unit_fast.h's
+ * cbvh_fast_floor_in_sig and cbvh_fast_floor and the codes and Eq. 2 child
+ * scale its cbvh_fast_code: the same inline steps the streaming compressor
+ * runs, so each has one definition.  Then 0 < |k|, |ku| < 2^24, |K| < 2^62,
+ * and:
  *   - clb = RD(k 2^e) is k 2^e itself, formed on lb's bit pattern
  *     (cbvh_fast_grid_below_in_sig; -2^128 comes out as -Inf);
  *   - with l = ku + 1, l 2^e (l != 0) has at most 24 significant bits or is
  *     a power of two, and e >= -126 keeps it normal: it is a binary32 value
  *     unless it overflows (RU gives +Inf), so pack_exact needs no rounding
- *     step; l = 0 gives +0.
+ *     step; l = 0 gives +0;
+ *   - OUTSIDE is the integer test of the spec, k < K or l - K > 2^N, in 64 bits.
  * These are the values compress_general forms (cbvh_grid_floor, its
- * cells and child scale, cbvh_grid_pack_signed).  tests/model/test_properties.c
- * and test_unit_fast.c check both paths against an FPU oracle. */
+ * cells and child scale, cbvh_grid_pack_signed, the window as values).
+ * tests/model/test_properties.c and test_unit_fast.c check both paths
+ * against an FPU oracle. */
 
 /* v * 2^e for 0 < |v| <= 2^24 and e >= -126: exact and normal (v has <= 24
  * significant bits or is 2^24), except overflow to +-Inf. */
@@ -87,17 +104,21 @@ static inline cbvh_f32 pack_exact(int32_t v, int e) {
     return biased >= (int)CBVH_F32_EXP_FIELD_MAX ? (sign | CBVH_F32_POS_INF) : r;
 }
 
-uint32_t cbvh_axis_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_axis_code *out) {
+uint32_t cbvh_axis_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node_clb,
+                            cbvh_axis_code *out) {
     int n = p->quant_bits, ms = p->min_scale;
     uint32_t dl, du;
+    int64_t kn;
     if ((uint32_t)(n - CBVH_N_MIN) > (uint32_t)(CBVH_N_MAX - CBVH_N_MIN) || ms < CBVH_SCALE_FLOOR || e < ms ||
         e > CBVH_SCALE_CEIL || !(cbvh_fast_in_sig(lb, e, &dl) & cbvh_fast_in_sig(ub, e, &du)) ||
-        cbvh_fast_order_key(lb) > cbvh_fast_order_key(ub))
-        return compress_general(p, lb, ub, e, out);
+        cbvh_fast_order_key(lb) > cbvh_fast_order_key(ub) || cbvh_grid_clb_bad(node_clb) ||
+        !cbvh_fast_floor(node_clb, e, &kn))
+        return compress_general(p, lb, ub, e, node_clb, out);
     int64_t k = cbvh_fast_floor_in_sig(lb, dl), ku = cbvh_fast_floor_in_sig(ub, du);
     int fit = cbvh_fast_code(n, ms, e, k, ku, &out->lb_mod, &out->ub_mod, &out->child_scale);
     if (!fit) out->child_scale = e;
     out->clb = cbvh_fast_grid_below_in_sig(lb, dl);
     out->cub = ku == -1 ? 0u : pack_exact((int32_t)(ku + 1), e);
-    return fit ? 0 : CBVH_ST_NO_FIT;
+    int outside = (k < kn) | (ku + 1 - kn > (INT64_C(1) << n));
+    return (fit ? 0 : CBVH_ST_NO_FIT) | (outside ? CBVH_ST_OUTSIDE : 0);
 }

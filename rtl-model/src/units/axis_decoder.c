@@ -18,7 +18,7 @@ uint32_t cbvh_axis_ctx_check(const cbvh_params *p, const cbvh_axis_ctx *c) {
         return CBVH_ST_BAD_SCALE;
     if (c->lb_mod > mask) return CBVH_ST_BAD_CODE;
     /* -Inf is the context's encoding of -2^128; +Inf and NaN are rejected. */
-    if (cbvh_f32_is_nan_or_inf(c->clb) && c->clb != CBVH_F32_NEG_INF) return CBVH_ST_NAN_INF;
+    if (cbvh_grid_clb_bad(c->clb)) return CBVH_ST_NAN_INF;
     return 0;
 }
 
@@ -146,8 +146,10 @@ uint32_t cbvh_axis_root_ctx(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, cbvh
     uint32_t st = cbvh_scale_estimate(p, lb, ub, &e);
     if (st) return st;
     cbvh_axis_code code;
-    st = cbvh_axis_compress(p, lb, ub, e, &code);
-    if (st) return st; /* cannot be NO_FIT: e was chosen to fit */
+    /* The root is the only child of a virtual node whose window starts at the
+     * root's own grid line: node_clb = lb (any value in that cell would do). */
+    st = cbvh_axis_compress(p, lb, ub, e, lb, &code);
+    if (st) return st; /* cannot be NO_FIT or OUTSIDE: e was chosen to fit */
     ctx->parent_scale = e;
     ctx->scale = code.child_scale;
     ctx->lb_mod = code.lb_mod;

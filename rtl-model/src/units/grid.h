@@ -174,4 +174,17 @@ static inline int cbvh_grid_child_scale(const cbvh_params *p, int e, uint64_t ce
 
 static inline uint32_t cbvh_grid_mask(const cbvh_params *p) { return (1u << p->quant_bits) - 1u; }
 
+/* A node's decoded lower bound as a context or compressor input: -Inf is the
+ * encoding of -2^128 (section 3), so only NaN and +Inf are faults. */
+static inline int cbvh_grid_clb_bad(cbvh_f32 clb) { return cbvh_f32_is_nan_or_inf(clb) && clb != CBVH_F32_NEG_INF; }
+
+/* floor(x / 2^e) 2^e, the grid line at or below a finite x (or -Inf =
+ * -2^128): a binary32 value (section 3), or -Inf for -2^128, and x itself
+ * when the coordinate is "huge" (then x is a multiple of 2^e); -0 gives +0. */
+static inline cbvh_f32 cbvh_grid_below(cbvh_f32 x, int e) {
+    int huge;
+    int64_t k = cbvh_grid_floor(x, e, &huge);
+    return huge ? (cbvh_f32_is_zero(x) ? 0u : x) : cbvh_grid_pack_signed(k, e, CBVH_RND_DOWN);
+}
+
 #endif

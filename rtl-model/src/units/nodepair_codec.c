@@ -90,7 +90,7 @@ uint32_t cbvh_nodepair_encode(const cbvh_params *p, cbvh_encoding enc, const cbv
         uint64_t codes = 0;
         for (int a = 0; a < 3; a++) {
             const cbvh_axis_ctx *ac = &ctx->axis[a];
-            st |= cbvh_axis_compress(p, child[c].lo[a], child[c].hi[a], ac->scale, &o->axis[a]);
+            st |= cbvh_axis_compress(p, child[c].lo[a], child[c].hi[a], ac->scale, ac->clb, &o->axis[a]);
             uint32_t lc, uc;
             cbvh_axis_store_codes(p, enc, ac, &o->axis[a], &lc, &uc);
             codes |= (uint64_t)lc << (2 * a * n) | (uint64_t)uc << (2 * a * n + n);

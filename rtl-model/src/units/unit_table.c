@@ -57,12 +57,13 @@ static void compress_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
     add(l->in, &l->n_in, "lb", F32);
     add(l->in, &l->n_in, "ub", F32);
     add(l->in, &l->n_in, "scale", SCALE);
+    add(l->in, &l->n_in, "node_clb", F32);
     code_layout(l);
     add(l->out, &l->n_out, "status", STATUS);
 }
 static void compress_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
     cbvh_axis_code c;
-    uint32_t st = cbvh_axis_compress(&cfg->params, in[0], in[1], cbvh_scale_from_word(in[2]), &c);
+    uint32_t st = cbvh_axis_compress(&cfg->params, in[0], in[1], cbvh_scale_from_word(in[2]), in[3], &c);
     code_words(&c, out);
     out[5] = st;
 }
