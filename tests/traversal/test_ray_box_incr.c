@@ -23,6 +23,7 @@
 #include "cbvh/ray_box_incr.h"
 #include "rbi_chain.h"
 #include "test_util.h"
+#include "fast/rbi_fast.h"
 #include "units/exact_wide.h"
 
 static long fails;
@@ -181,6 +182,31 @@ static cbvh_f32 oracle_anchor_plane(cbvh_f32 u, int e, uint32_t k, cbvh_f32 o, c
     return r;
 }
 
+/* The fast path as this file compiles it (SSE2 lanes, or one plane at a time
+ * with -DCBVH_NO_SSE2: test traversal_ray_box_incr.plain) against the unit's
+ * outputs: 1 if equal. */
+static int fast_matches(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, const cbvh_rbi_planes *par,
+                        const cbvh_rbi_axis ax[3], const cbvh_rbi_result *want) {
+    if (!CBVH_RBI_FAST) return 1;
+    cbvh_rbi_fray f;
+    cbvh_rbi_fnode n, ch;
+    int e[3];
+    uint32_t r[3], sp[3];
+    for (int a = 0; a < 3; a++) e[a] = ax[a].e, r[a] = ax[a].r, sp[a] = ax[a].sp;
+    cbvh_rbi_fprep(p, ray, &f);
+    cbvh_rbi_fnode_of(&f, par, e, &n);
+    double tn, tf;
+    cbvh_rbi_result got;
+    memset(&got, 0, sizeof got);
+    if (cbvh_rbi_ftest(&f, cbvh_rbi_d(ray->tmax), &n, r, sp, &ch, &tn, &tf)) {
+        got.hit = 1;
+        got.t_near = cbvh_rbi_f(tn);
+        got.t_far = cbvh_rbi_f(tf);
+        for (int a = 0; a < 3; a++) got.planes.t_lb[a] = cbvh_rbi_f(ch.t[a][0]), got.planes.t_ub[a] = cbvh_rbi_f(ch.t[a][1]);
+    }
+    return memcmp(&got, want, sizeof got) == 0;
+}
+
 /* ---- random inputs ------------------------------------------------------ */
 static int rand_M(void) { return below(4) ? MS[below(5)] : 3 + (int)below(22); }
 static int rand_X(void) { return below(3) ? 8 : 3 + (int)below(6); }
@@ -265,6 +291,10 @@ static int run_oracle(long count) {
         int bad_tmin = cbvh_f32_is_nan_or_inf(ray.tmin); /* rand_f32 never gives NaN/Inf: status must be 0 */
         CHECK(st == 0 && !bad_tmin, "oracle input %ld: status %02x", i, st);
         oracle_unit(&p, &ray, &par, ch, &want);
+        cbvh_rbi_result gi;
+        uint32_t sti = cbvh_ray_box_incr_int(&p, &ray, &par, ch, &gi);
+        CHECK(sti == st && memcmp(&gi, &got, sizeof gi) == 0, "oracle input %ld: integer path != the unit", i);
+        if (st == 0) CHECK(fast_matches(&p, &ray, &par, ch, &got), "oracle input %ld: fast path (this build) != the unit", i);
         if (memcmp(&got, &want, sizeof got) != 0) {
             CHECK(0, "oracle input %ld (N %d M %d X %d): unit != oracle", i, p.quant_bits, M, X);
             if (fails <= 5) {
@@ -318,15 +348,63 @@ static int run_oracle(long count) {
             }
         }
     }
-    printf("oracle: %ld unit inputs (%ld hits, %ld planes with cancellation), %ld reciprocals, %ld anchors\n", count,
-           hits, cancel, count, (count + 3) / 4);
+    /* the edges of F: parent distances at +-max, +-2^emin and one unit inside
+     * them, increments of +-1/2, 1, 3/2 units, 2^emin and 2^(emax+1) - max on
+     * either plane and either sign of rho, for every M and X */
+    long edges = 0;
+    for (int X = 3; X <= 8; X++)
+        for (int M = 3; M <= 24; M++) {
+            cbvh_rbi_params p = {10, M, X};
+            int emax = cbvh_rbi_emax(X), emin = cbvh_rbi_emin(X);
+            uint64_t qmax = (UINT64_C(1) << M) - 1, qmin = UINT64_C(1) << (M - 1);
+            const cbvh_f32 ts[6] = {pack(0, emax, qmax, M), pack(1, emax, qmax, M), pack(0, emin, qmin, M),
+                                    pack(1, emin, qmin, M), pack(0, emin, qmin + 1, M), pack(0, emax, qmax - 1, M)};
+            for (int k = 0; k < 6; k++)
+                for (int step = 0; step < 6; step++)
+                    for (int sg = 0; sg < 4; sg++) {
+                        /* rho = +-2^x with x chosen so that r 2^e rho is the wanted step */
+                        int E = k < 2 || k == 5 ? emax : emin, ulp = E - (M - 1);
+                        static const int st_exp[6] = {-1, 0, -1, 0, 0, 1}; /* 2^(ulp + st_exp) x st_c */
+                        static const uint32_t st_c[6] = {1, 1, 3, 1, 1, 1};
+                        int target = step == 4 ? emin : ulp + st_exp[step];
+                        if (step == 5) target = emax + 1 - M; /* 2^(emax+1) - max */
+                        cbvh_rbi_ray ray = {{0, 0, 0}, 0, CBVH_F32_POS_INF};
+                        int rx = target - 0, e = 0; /* rho = 2^rx at e = 0, clamped into the ranges */
+                        if (rx > 127) e = rx - 127, rx = 127;
+                        if (rx < -126) e = rx + 126, rx = -126;
+                        if (e < -126 || e > 126) continue;
+                        ray.rcp[0] = rbi_pow2(sg & 1, rx);
+                        ray.tmin = 0xFF7FFFFFu; /* -FLT_MAX: keeps every hit */
+                        /* every other plane finite (+-max, rho = 0 on y and z), so that the SSE2 lanes
+                         * decide; the tested plane is axis 0's lower (sg & 2 = 0) or upper one */
+                        cbvh_f32 big = pack(0, emax, qmax, M);
+                        cbvh_rbi_planes par = {{big | CBVH_F32_SIGN, big | CBVH_F32_SIGN, big | CBVH_F32_SIGN},
+                                               {big, big, big}};
+                        cbvh_rbi_axis ch[3] = {{e, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+                        int near_is_lb = !(ray.rcp[0] >> 31), tested_lb = !(sg & 2);
+                        cbvh_f32 other = tested_lb == near_is_lb ? big : big | CBVH_F32_SIGN; /* far +max, near -max */
+                        if (tested_lb) par.t_lb[0] = ts[k], par.t_ub[0] = other, ch[0].r = st_c[step];
+                        else par.t_ub[0] = ts[k], par.t_lb[0] = other, ch[0].sp = st_c[step];
+                        cbvh_rbi_result got, want, gi;
+                        uint32_t st = cbvh_ray_box_incr(&p, &ray, &par, ch, &got);
+                        oracle_unit(&p, &ray, &par, ch, &want);
+                        cbvh_ray_box_incr_int(&p, &ray, &par, ch, &gi);
+                        CHECK(st == 0 && !memcmp(&got, &want, sizeof got) && !memcmp(&gi, &got, sizeof gi) &&
+                                  fast_matches(&p, &ray, &par, ch, &got),
+                              "edge case M %d X %d t %08x step %d sign %d: status %02x, unit/oracle/integer differ", M, X,
+                              ts[k], step, sg, st);
+                        edges++;
+                    }
+        }
+    printf("oracle: %ld unit inputs (%ld hits, %ld planes with cancellation), %ld reciprocals, %ld anchors, %ld edge cases\n",
+           count, hits, cancel, count, (count + 3) / 4, edges);
     CHECK(hits > count / 10 && cancel > count / 100, "too few hits (%ld) or cancellations (%ld)", hits, cancel);
     return 0;
 }
 
 /* ---- conservativeness on chains ---------------------------------------- */
 typedef struct {
-    long children, ex_hits, inc_hits, fp, planes_checked;
+    long children, ex_hits, inc_hits, fp, planes_checked, int_checked;
     int max_depth;
 } kind_stats;
 
@@ -376,6 +454,7 @@ static int run_chains(long count) {
         rbi_child ch[2];
         int more = 1;
         while (more && done < count) {
+            cbvh_rbi_planes Tpar = c.T; /* the step descends: keep the parent's distances */
             more = rbi_chain_step(&c, ch);
             for (int j = 0; j < 2; j++) {
                 rbi_child *x = &ch[j];
@@ -383,6 +462,16 @@ static int run_chains(long count) {
                 k->children++;
                 CHECK(x->inc_st == 0 && x->ex_st == 0, "%s: status incremental %02x exact %02x",
                       rbi_kind_names[kind], x->inc_st, x->ex_st);
+                if ((done & 3) == 0) { /* the integer path gives the unit's bits */
+                    cbvh_rbi_result gi;
+                    uint32_t sti = cbvh_ray_box_incr_int(&p, &c.rr, &Tpar, x->ax, &gi);
+                    CHECK(sti == x->inc_st && memcmp(&gi, &x->inc, sizeof gi) == 0,
+                          "%s: integer path != the unit (depth %d)", rbi_kind_names[kind], c.depth);
+                    if (x->inc_st == 0)
+                        CHECK(fast_matches(&p, &c.rr, &Tpar, x->ax, &x->inc), "%s: fast path (this build) != the unit",
+                              rbi_kind_names[kind]);
+                    k->int_checked++;
+                }
                 k->ex_hits += x->ex.hit;
                 k->inc_hits += x->inc.hit;
                 k->fp += x->inc.hit && !x->ex.hit;

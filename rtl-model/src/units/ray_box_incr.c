@@ -60,6 +60,7 @@
 #include <string.h>
 
 #include "fast/ray_prep.h"
+#include "fast/rbi_fast.h"
 #include "units/exact_wide.h"
 #include "units/grid.h"
 
@@ -287,8 +288,9 @@ static uint32_t unit_status(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, c
     return st;
 }
 
-uint32_t cbvh_ray_box_incr(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, const cbvh_rbi_planes *parent,
-                           const cbvh_rbi_axis child[3], cbvh_rbi_result *out) {
+/* The integer path: the unit's definition, step by step. */
+uint32_t cbvh_ray_box_incr_int(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, const cbvh_rbi_planes *parent,
+                               const cbvh_rbi_axis child[3], cbvh_rbi_result *out) {
     memset(out, 0, sizeof *out);
     uint32_t st = unit_status(p, ray, parent, child);
     if (st) return st;
@@ -317,5 +319,31 @@ uint32_t cbvh_ray_box_incr(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, co
     out->t_near = cbvh_f32_is_zero(tn) ? 0u : tn;
     out->t_far = cbvh_f32_is_zero(tf) ? 0u : tf;
     out->planes = pl;
+    return 0;
+}
+
+/* The unit: its status, then the binary64 path of fast/rbi_fast.h, which
+ * gives the integer path's bits (proof there), or the integer path. */
+uint32_t cbvh_ray_box_incr(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, const cbvh_rbi_planes *parent,
+                           const cbvh_rbi_axis child[3], cbvh_rbi_result *out) {
+    if (!CBVH_RBI_FAST) return cbvh_ray_box_incr_int(p, ray, parent, child, out);
+    memset(out, 0, sizeof *out);
+    uint32_t st = unit_status(p, ray, parent, child);
+    if (st) return st;
+    cbvh_rbi_fray f;
+    cbvh_rbi_fnode par, ch;
+    double tn, tf;
+    int e[3] = {child[0].e, child[1].e, child[2].e};
+    uint32_t r[3] = {child[0].r, child[1].r, child[2].r}, sp[3] = {child[0].sp, child[1].sp, child[2].sp};
+    cbvh_rbi_fprep(p, ray, &f);
+    cbvh_rbi_fnode_of(&f, parent, e, &par);
+    if (!cbvh_rbi_ftest(&f, cbvh_rbi_d(ray->tmax), &par, r, sp, &ch, &tn, &tf)) return 0;
+    out->hit = 1;
+    out->t_near = cbvh_rbi_f(tn);
+    out->t_far = cbvh_rbi_f(tf);
+    for (int a = 0; a < 3; a++) {
+        out->planes.t_lb[a] = cbvh_rbi_f(ch.t[a][0]);
+        out->planes.t_ub[a] = cbvh_rbi_f(ch.t[a][1]);
+    }
     return 0;
 }
