@@ -120,6 +120,81 @@ static inline int rbi_plane_f32(cbvh_f32 u, int e, uint32_t k, cbvh_f32 *out) {
     return 1;
 }
 
+/* The value (-1)^neg q 2^(E-M+1) of F(M, X) as a binary32 (2^(M-1) <= q < 2^M). */
+static inline cbvh_f32 rbi_pack(int neg, int E, uint64_t q, int M) {
+    return (neg ? CBVH_F32_SIGN : 0u) | (uint32_t)(E + 127) << 23 | ((uint32_t)q << (24 - M) & CBVH_F32_FRAC);
+}
+
+/* A random binary32: 0, subnormal, moderate or any normal exponent (no NaN or Inf). */
+static inline cbvh_f32 rbi_rand_f32(uint64_t *rng) {
+    uint64_t k = tu_xorshift64(rng) % 10;
+    uint32_t sign = (tu_xorshift64(rng) & 1) ? CBVH_F32_SIGN : 0u;
+    if (k == 0) return sign;
+    if (k == 1) return sign | (uint32_t)(1 + tu_xorshift64(rng) % 0x7FFFFF);
+    int E = k <= 6 ? (int)(tu_xorshift64(rng) % 21) - 10 : (int)(tu_xorshift64(rng) % 254) - 126;
+    return sign | (uint32_t)(E + 127) << 23 | (uint32_t)(tu_xorshift64(rng) & CBVH_F32_FRAC);
+}
+
+/* A random value of F(M, X) near 2^near_exp: mostly normal, sometimes 0, +-Inf, the extremes. */
+static inline cbvh_f32 rbi_rand_fmt(uint64_t *rng, int M, int X, int near_exp) {
+    int emax = cbvh_rbi_emax(X), emin = cbvh_rbi_emin(X);
+    uint64_t k = tu_xorshift64(rng) % 32;
+    int neg = (int)(tu_xorshift64(rng) & 1);
+    if (k == 0) return neg ? CBVH_F32_SIGN : 0u;
+    if (k == 1) return neg ? CBVH_F32_NEG_INF : CBVH_F32_POS_INF;
+    int E = k == 2 ? emax : k == 3 ? emin : near_exp + (int)(tu_xorshift64(rng) % 9) - 4;
+    if (tu_xorshift64(rng) % 4 == 0) E = emin + (int)(tu_xorshift64(rng) % (uint64_t)(emax - emin + 1));
+    E = E > emax ? emax : E < emin ? emin : E;
+    uint64_t q = (UINT64_C(1) << (M - 1)) | (tu_xorshift64(rng) & ((UINT64_C(1) << (M - 1)) - 1));
+    if (tu_xorshift64(rng) % 8 == 0) q = UINT64_C(1) << (M - 1);
+    if (tu_xorshift64(rng) % 8 == 0) q = (UINT64_C(1) << M) - 1;
+    return rbi_pack(neg, E, q, M);
+}
+
+/* Random valid inputs of the unit at design point p: half of them shaped to
+ * hit (near distances of either sign below positive far ones, increments a
+ * few bits below the distances: cancellations and carries), half wild
+ * (distances anywhere in F, +-0, +-Inf, any scale); reciprocals of random
+ * directions, sometimes +-0. */
+static inline void rbi_random_inputs(uint64_t *rng, const cbvh_rbi_params *p, cbvh_rbi_ray *ray, cbvh_rbi_planes *par,
+                                     cbvh_rbi_axis ch[3]) {
+    int M = p->mant, X = p->texp, rexp[3];
+    for (int a = 0; a < 3; a++) {
+        cbvh_f32 d = tu_xorshift64(rng) % 8 == 0 ? rbi_rand_f32(rng) : rbi_f32(tu_unit_d(rng) * 2 - 1);
+        cbvh_rbi_reciprocal(d, M, &ray->rcp[a]);
+        if (tu_xorshift64(rng) % 16 == 0) ray->rcp[a] = (tu_xorshift64(rng) & 1) ? CBVH_F32_SIGN : 0u;
+        rexp[a] = cbvh_f32_is_zero(ray->rcp[a]) ? 0 : (int)((ray->rcp[a] >> 23) & 0xFF) - 127;
+    }
+    int te = (int)(tu_xorshift64(rng) % 40) - 20, shaped = (tu_xorshift64(rng) & 1) != 0;
+    ray->tmin = tu_xorshift64(rng) % 4 ? 0u : rbi_rand_f32(rng);
+    ray->tmax = tu_xorshift64(rng) % 2 ? CBVH_F32_POS_INF : rbi_rand_f32(rng) & ~CBVH_F32_SIGN;
+    if (shaped && tu_xorshift64(rng) % 4) ray->tmin = 0, ray->tmax = CBVH_F32_POS_INF;
+    for (int a = 0; a < 3; a++) {
+        cbvh_f32 n = rbi_rand_fmt(rng, M, X, te), f = rbi_rand_fmt(rng, M, X, te + (int)(tu_xorshift64(rng) % 3));
+        if (shaped) {
+            int emax = cbvh_rbi_emax(X), emin = cbvh_rbi_emin(X), ts = te;
+            ts = ts > emax - 4 ? emax - 4 : ts;
+            ts = ts < emin + 4 ? emin + 4 : ts;
+            uint64_t qm = (UINT64_C(1) << (M - 1)) - 1;
+            int En = ts - 1 - (int)(tu_xorshift64(rng) % 3), Ef = ts + 1 + (int)(tu_xorshift64(rng) % 3);
+            En = En < emin ? emin : En > emax ? emax : En;
+            Ef = Ef < emin ? emin : Ef > emax ? emax : Ef;
+            n = rbi_pack(tu_xorshift64(rng) % 4 == 0, En, (qm + 1) | (tu_xorshift64(rng) & qm), M);
+            f = rbi_pack(0, Ef, (qm + 1) | (tu_xorshift64(rng) & qm), M);
+        }
+        int neg = (ray->rcp[a] >> 31) != 0;
+        par->t_lb[a] = neg ? f : n;
+        par->t_ub[a] = neg ? n : f;
+        uint32_t lim = UINT32_C(1) << p->quant_bits;
+        ch[a].r = (uint32_t)(tu_xorshift64(rng) % lim);
+        ch[a].sp = (uint32_t)(tu_xorshift64(rng) % (lim - ch[a].r));
+        int e = te - rexp[a] - (int)(tu_xorshift64(rng) % (uint64_t)(p->quant_bits + 4)) + (int)(tu_xorshift64(rng) % 6);
+        if (shaped) e = te - rexp[a] - p->quant_bits - 3 + (int)(tu_xorshift64(rng) % 4);
+        if (tu_xorshift64(rng) % 8 == 0) e = (int)(tu_xorshift64(rng) % 253) - 126;
+        ch[a].e = e < -126 ? -126 : e > 126 ? 126 : e;
+    }
+}
+
 /* Starts a chain: a ray and a root box of the given kind, and the root's
  * plane distances (cbvh_rbi_anchor).  Returns 0, or -1 if the unit rejects
  * the ray (never for the kinds above). */

@@ -66,9 +66,7 @@ static int q_log2(const mpq_t x) {
     mpq_clears(a, p, NULL);
     return e;
 }
-static cbvh_f32 pack(int neg, int E, uint64_t q, int M) {
-    return (neg ? CBVH_F32_SIGN : 0u) | (uint32_t)(E + 127) << 23 | ((uint32_t)q << (24 - M) & CBVH_F32_FRAC);
-}
+static cbvh_f32 pack(int neg, int E, uint64_t q, int M) { return rbi_pack(neg, E, q, M); }
 /* RND_F written from the spec (§17.1), independently of cbvh_rbi_round. */
 static cbvh_f32 oracle_round(const mpq_t x, int up, int M, int X) {
     if (mpq_sgn(x) == 0) return 0;
@@ -211,30 +209,7 @@ static int fast_matches(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, const
 static int rand_M(void) { return below(4) ? MS[below(5)] : 3 + (int)below(22); }
 static int rand_X(void) { return below(3) ? 8 : 3 + (int)below(6); }
 
-/* A random value of F(M, X): mostly normal, sometimes 0, +-Inf, the extremes. */
-static cbvh_f32 rand_fmt(int M, int X, int near_exp) {
-    int emax = cbvh_rbi_emax(X), emin = cbvh_rbi_emin(X);
-    uint64_t k = below(32);
-    int neg = (int)below(2);
-    if (k == 0) return neg ? CBVH_F32_SIGN : 0u;
-    if (k == 1) return neg ? CBVH_F32_NEG_INF : CBVH_F32_POS_INF;
-    int E = k == 2 ? emax : k == 3 ? emin : near_exp + (int)below(9) - 4;
-    if (below(4) == 0) E = emin + (int)below((uint64_t)(emax - emin + 1));
-    if (E > emax) E = emax;
-    if (E < emin) E = emin;
-    uint64_t q = (UINT64_C(1) << (M - 1)) | (rnd() & ((UINT64_C(1) << (M - 1)) - 1));
-    if (below(8) == 0) q = UINT64_C(1) << (M - 1);
-    if (below(8) == 0) q = (UINT64_C(1) << M) - 1;
-    return pack(neg, E, q, M);
-}
-static cbvh_f32 rand_f32(void) {
-    uint64_t k = below(10);
-    uint32_t sign = below(2) ? CBVH_F32_SIGN : 0u;
-    if (k == 0) return sign;
-    if (k == 1) return sign | (uint32_t)(1 + below(0x7FFFFF));
-    int E = k <= 6 ? (int)below(21) - 10 : (int)below(254) - 126;
-    return sign | (uint32_t)(E + 127) << 23 | (uint32_t)(rnd() & CBVH_F32_FRAC);
-}
+static cbvh_f32 rand_f32(void) { return rbi_rand_f32(&rs); }
 
 static void print_result(const char *who, const cbvh_rbi_result *r) {
     printf("  %s: hit %d near %08x far %08x lb %08x %08x %08x ub %08x %08x %08x\n", who, r->hit, r->t_near, r->t_far,
@@ -248,44 +223,9 @@ static int run_oracle(long count) {
         cbvh_rbi_params p = {3 + (int)below(8), rand_M(), rand_X()};
         int M = p.mant, X = p.texp;
         cbvh_rbi_ray ray;
-        int rexp[3];
-        for (int a = 0; a < 3; a++) {
-            cbvh_f32 d = below(8) == 0 ? rand_f32() : rbi_f32((double)(tu_unit_d(&rs) * 2 - 1));
-            cbvh_rbi_reciprocal(d, M, &ray.rcp[a]);
-            if (below(16) == 0) ray.rcp[a] = (below(2) ? CBVH_F32_SIGN : 0u);
-            rexp[a] = cbvh_f32_is_zero(ray.rcp[a]) ? 0 : (int)((ray.rcp[a] >> 23) & 0xFF) - 127;
-        }
-        int te = (int)below(40) - 20, shaped = below(2) != 0; /* near distances below the far ones: mostly hits */
-        ray.tmin = below(4) ? 0u : rand_f32();
-        ray.tmax = below(2) ? CBVH_F32_POS_INF : rand_f32() & ~CBVH_F32_SIGN;
-        if (shaped && below(4)) ray.tmin = 0, ray.tmax = CBVH_F32_POS_INF;
         cbvh_rbi_planes par;
         cbvh_rbi_axis ch[3];
-        for (int a = 0; a < 3; a++) {
-            cbvh_f32 n = rand_fmt(M, X, te), f = rand_fmt(M, X, te + (int)below(3));
-            if (shaped) { /* near: either sign (origin inside or before the box); far: positive, larger */
-                int emax = cbvh_rbi_emax(X), emin = cbvh_rbi_emin(X), ts = te;
-                if (ts > emax - 4) ts = emax - 4;
-                if (ts < emin + 4) ts = emin + 4;
-                uint64_t qm = (UINT64_C(1) << (M - 1)) - 1;
-                int En = ts - 1 - (int)below(3), Ef = ts + 1 + (int)below(3);
-                En = En < emin ? emin : En > emax ? emax : En;
-                Ef = Ef < emin ? emin : Ef > emax ? emax : Ef;
-                n = pack((int)below(4) == 0, En, (qm + 1) | (rnd() & qm), M);
-                f = pack(0, Ef, (qm + 1) | (rnd() & qm), M);
-            }
-            int neg = (ray.rcp[a] >> 31) != 0;
-            par.t_lb[a] = neg ? f : n;
-            par.t_ub[a] = neg ? n : f;
-            uint32_t lim = UINT32_C(1) << p.quant_bits;
-            ch[a].r = (uint32_t)below(lim);
-            ch[a].sp = (uint32_t)below(lim - ch[a].r);
-            /* the increment near the parent's distance: cancellation and carries */
-            int e = te - rexp[a] - (int)below((uint64_t)p.quant_bits + 4) + (int)below(6);
-            if (shaped) e = te - rexp[a] - p.quant_bits - 3 + (int)below(4);
-            if (below(8) == 0) e = (int)below(253) - 126;
-            ch[a].e = e < -126 ? -126 : e > 126 ? 126 : e;
-        }
+        rbi_random_inputs(&rs, &p, &ray, &par, ch);
         cbvh_rbi_result got, want;
         uint32_t st = cbvh_ray_box_incr(&p, &ray, &par, ch, &got);
         int bad_tmin = cbvh_f32_is_nan_or_inf(ray.tmin); /* rand_f32 never gives NaN/Inf: status must be 0 */
