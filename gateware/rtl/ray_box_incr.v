@@ -128,28 +128,47 @@ module cbvh_ray_box_incr #(
             wire [1:0] ax = k[2:1];             // its axis
             wire       ub = k[0];               // 1: the upper plane, t_ub - s' 2^e rho
             wire [31:0] rc = a_rcp[ax];
+            wire        par = (rc[30:0] == 31'd0);  // a parallel axis: offsets stepped with rho = 1
             // toward -Inf where the increment is >= 0: lower plane and rho >= +0, or upper plane and rho < 0
             cbvh_rbi_step #(.N(N), .M(M), .X(X)) step (
-                .clk(clk), .t(ub ? a_ub[ax] : a_lb[ax]), .rho(rc), .c(ub ? a_sp[ax][N-1:0] : a_r[ax][N-1:0]),
-                .e(a_e[ax]), .sub(ub), .up(rc[31] ^ ub), .res(res[g]));
+                .clk(clk), .t(ub ? a_ub[ax] : a_lb[ax]), .rho(par ? 32'h3F800000 : rc),
+                .c(ub ? a_sp[ax][N-1:0] : a_r[ax][N-1:0]), .e(a_e[ax]), .sub(ub), .up(par ? ub : rc[31] ^ ub),
+                .res(res[g]));
         end
     endgenerate
 
-    // status, tmin/tmax and the rho signs go with the last phase (A holds the test through its phases)
+    // binary32 value order as an unsigned key: -0 and +0 get one key, and
+    // unkey(key(f)) is f with -0 made +0 (the outputs' canonical zero)
+    function [31:0] fkey;
+        input [31:0] f;
+        begin
+            if (f[30:0] == 31'd0) fkey = 32'h80000000;
+            else if (f[31])       fkey = ~f;
+            else                  fkey = {1'b1, f[30:0]};
+        end
+    endfunction
+    function [31:0] unkey; input [31:0] k; unkey = k[31] ? {1'b0, k[30:0]} : ~k; endfunction
+
+    // valid and phase beside the datapaths in flip-flops; status, the keys of
+    // tmin/tmax and the rho signs (A holds the test through its phases, so
+    // the last phase carries them) in a block-RAM delay line
     reg        v_d  [0:SD-1];
     reg [2:0]  ph_d [0:SD-1];
-    reg [7:0]  st_d [0:SD-1];
-    reg [31:0] tmin_d [0:SD-1], tmax_d [0:SD-1];
-    reg [2:0]  neg_d [0:SD-1];
     integer j;
     always @(posedge clk) begin
-        v_d[0] <= a_v && last; ph_d[0] <= ph; st_d[0] <= st_a; tmin_d[0] <= a_tmin; tmax_d[0] <= a_tmax;
-        neg_d[0] <= {a_rcp[2][31], a_rcp[1][31], a_rcp[0][31]};
+        v_d[0] <= a_v && last; ph_d[0] <= ph;
         for (j = 1; j < SD; j = j + 1) begin
-            v_d[j] <= v_d[j-1]; ph_d[j] <= ph_d[j-1]; st_d[j] <= st_d[j-1];
-            tmin_d[j] <= tmin_d[j-1]; tmax_d[j] <= tmax_d[j-1]; neg_d[j] <= neg_d[j-1];
+            v_d[j] <= v_d[j-1]; ph_d[j] <= ph_d[j-1];
         end
     end
+    wire [2:0] par_a = {a_rcp[2][30:0] == 31'd0, a_rcp[1][30:0] == 31'd0, a_rcp[0][30:0] == 31'd0};
+    wire [77:0] side_d;
+    cbvh_rbi_delay #(.W(78), .D(SD)) side (.clk(clk),
+        .din({st_a, fkey(a_tmin), fkey(a_tmax), par_a, a_rcp[2][31], a_rcp[1][31], a_rcp[0][31]}), .dout(side_d));
+    wire [7:0]  st_e = side_d[77:70];
+    wire [31:0] kmin_e = side_d[69:38], kmax_e = side_d[37:6];
+    wire [2:0]  pa = side_d[5:3];
+    wire [2:0]  ng = side_d[2:0] & ~pa;   // the upper plane is the near one
 
     // ---- collect: the earlier phases' results wait; the last phase's join them ----
     /* verilator lint_off UNUSEDSIGNAL */ // at P = 6 no result waits: col is empty
@@ -173,52 +192,50 @@ module cbvh_ray_box_incr #(
     assign c_lb[1] = cur[2]; assign c_ub[1] = cur[3];
     assign c_lb[2] = cur[4]; assign c_ub[2] = cur[5];
 
-    // ---- near/far, two comparator levels, hit ----
-    function [31:0] fkey;   // binary32 value order, -0 = +0
-        input [31:0] f;
-        begin
-            if (f[30:0] == 31'd0) fkey = 32'h80000000;
-            else if (f[31])       fkey = ~f;
-            else                  fkey = {1'b1, f[30:0]};
-        end
-    endfunction
-    function [31:0] fmax2; input [31:0] a, b; fmax2 = (fkey(b) > fkey(a)) ? b : a; endfunction
-    function [31:0] fmin2; input [31:0] a, b; fmin2 = (fkey(b) < fkey(a)) ? b : a; endfunction
+    // ---- near/far per axis as keys, t_near = max and t_far = min in two comparator levels, hit ----
+    function [31:0] kmax; input [31:0] a, b; kmax = b > a ? b : a; endfunction
+    function [31:0] kmin; input [31:0] a, b; kmin = b < a ? b : a; endfunction
+    // a parallel axis takes no part in t_near, t_far (keys 0 and all ones) but
+    // needs lower - o <= 0 <= upper - o
+    localparam [31:0] K_ZERO = 32'h80000000;
+    wire [31:0] n0 = pa[0] ? 32'd0 : fkey(ng[0] ? c_ub[0] : c_lb[0]), f0 = pa[0] ? ~32'd0 : fkey(ng[0] ? c_lb[0] : c_ub[0]);
+    wire [31:0] n1 = pa[1] ? 32'd0 : fkey(ng[1] ? c_ub[1] : c_lb[1]), f1 = pa[1] ? ~32'd0 : fkey(ng[1] ? c_lb[1] : c_ub[1]);
+    wire [31:0] n2 = pa[2] ? 32'd0 : fkey(ng[2] ? c_ub[2] : c_lb[2]), f2 = pa[2] ? ~32'd0 : fkey(ng[2] ? c_lb[2] : c_ub[2]);
+    wire outside = (pa[0] && (fkey(c_lb[0]) > K_ZERO || fkey(c_ub[0]) < K_ZERO)) ||
+                   (pa[1] && (fkey(c_lb[1]) > K_ZERO || fkey(c_ub[1]) < K_ZERO)) ||
+                   (pa[2] && (fkey(c_lb[2]) > K_ZERO || fkey(c_ub[2]) < K_ZERO));
 
-    wire [2:0] ng = neg_d[SD-1];
-    wire [31:0] n0 = ng[0] ? c_ub[0] : c_lb[0], f0 = ng[0] ? c_lb[0] : c_ub[0];
-    wire [31:0] n1 = ng[1] ? c_ub[1] : c_lb[1], f1 = ng[1] ? c_lb[1] : c_ub[1];
-    wire [31:0] n2 = ng[2] ? c_ub[2] : c_lb[2], f2 = ng[2] ? c_lb[2] : c_ub[2];
-
-    reg        h_v;
+    // stage H1: the first comparator level; H2: the second; J: hit and the
+    // outputs.  The six distances wait two clocks in a block-RAM delay line.
+    reg        h_v, h_out;
     reg [7:0]  h_st;
-    reg [31:0] h_n01, h_n2t, h_f01, h_f2t, h_pl [0:5];
-    always @(posedge clk) begin   // stage H
-        h_v <= v_d[SD-1]; h_st <= st_d[SD-1];   // v_d: the test's last phase
-        h_n01 <= fmax2(n0, n1); h_n2t <= fmax2(tmin_d[SD-1], n2);
-        h_f01 <= fmin2(f0, f1); h_f2t <= fmin2(tmax_d[SD-1], f2);
-        h_pl[0] <= c_lb[0]; h_pl[1] <= c_ub[0]; h_pl[2] <= c_lb[1];
-        h_pl[3] <= c_ub[1]; h_pl[4] <= c_lb[2]; h_pl[5] <= c_ub[2];
+    reg [31:0] h_n01, h_n2t, h_f01, h_f2t;
+    always @(posedge clk) begin   // H1 (v_d: the test's last phase; ties keep tmin's key: the same value)
+        h_v <= v_d[SD-1]; h_st <= st_e; h_out <= outside;
+        h_n01 <= kmax(n0, n1); h_n2t <= kmax(kmin_e, n2);
+        h_f01 <= kmin(f0, f1); h_f2t <= kmin(kmax_e, f2);
     end
-    reg        i_v;
+    reg        i_v, i_out;
     reg [7:0]  i_st;
-    reg [31:0] i_tn, i_tf, i_pl [0:5];
-    always @(posedge clk) begin   // stage I (tmin first on ties: the value is the same)
-        i_v <= h_v; i_st <= h_st;
-        i_tn <= fmax2(h_n2t, h_n01);
-        i_tf <= fmin2(h_f2t, h_f01);
-        for (j = 0; j < 6; j = j + 1) i_pl[j] <= h_pl[j];
+    reg [31:0] i_tn, i_tf;
+    always @(posedge clk) begin   // H2
+        i_v <= h_v; i_st <= h_st; i_out <= h_out;
+        i_tn <= kmax(h_n2t, h_n01);
+        i_tf <= kmin(h_f2t, h_f01);
     end
-    wire i_hit = (i_st == 8'd0) && !(fkey(i_tn) > fkey(i_tf));
-    always @(posedge clk) begin   // stage J: the outputs
+    wire [191:0] pl_d;
+    cbvh_rbi_delay #(.W(192), .D(2)) planes (.clk(clk),
+        .din({c_lb[0], c_ub[0], c_lb[1], c_ub[1], c_lb[2], c_ub[2]}), .dout(pl_d));
+    wire i_hit = (i_st == 8'd0) && !i_out && !(i_tn > i_tf);
+    always @(posedge clk) begin   // J: the outputs
         out_valid <= i_v;
         status <= i_st;
         hit <= i_hit;
-        t_near <= (i_hit && i_tn[30:0] != 31'd0) ? i_tn : 32'd0;
-        t_far  <= (i_hit && i_tf[30:0] != 31'd0) ? i_tf : 32'd0;
-        x_c_lb <= i_hit ? i_pl[0] : 32'd0; x_c_ub <= i_hit ? i_pl[1] : 32'd0;
-        y_c_lb <= i_hit ? i_pl[2] : 32'd0; y_c_ub <= i_hit ? i_pl[3] : 32'd0;
-        z_c_lb <= i_hit ? i_pl[4] : 32'd0; z_c_ub <= i_hit ? i_pl[5] : 32'd0;
+        t_near <= i_hit ? unkey(i_tn) : 32'd0;
+        t_far  <= i_hit ? unkey(i_tf) : 32'd0;
+        x_c_lb <= i_hit ? pl_d[191:160] : 32'd0; x_c_ub <= i_hit ? pl_d[159:128] : 32'd0;
+        y_c_lb <= i_hit ? pl_d[127:96] : 32'd0;  y_c_ub <= i_hit ? pl_d[95:64] : 32'd0;
+        z_c_lb <= i_hit ? pl_d[63:32] : 32'd0;   z_c_ub <= i_hit ? pl_d[31:0] : 32'd0;
     end
 endmodule
 
@@ -414,5 +431,28 @@ module cbvh_rbi_step #(
         else if (f_e > EMAXS) res <= away ? {f_neg, 8'hFF, 23'd0} : {f_neg, BMAX, fmax};
         else if (eq > EMAXS)  res <= {f_neg, 8'hFF, 23'd0};      // a carry past the largest binade
         else res <= {f_neg, be, fx};
+    end
+endmodule
+
+// A D-clock delay line (2 <= D <= 8) in block RAM: written every clock,
+// read D - 1 entries behind with a registered read.  Its first D outputs
+// after power-up are whatever the RAM holds; the unit uses them only beside
+// a valid test.
+/* verilator lint_off DECLFILENAME */ // the unit's delay line, kept with it
+module cbvh_rbi_delay #(parameter integer W = 8, parameter integer D = 6) (
+    input  wire         clk,
+    input  wire [W-1:0] din,
+    output reg  [W-1:0] dout
+);
+/* verilator lint_on DECLFILENAME */
+    localparam integer BACK = 9 - D;
+    localparam [2:0] RA_OFF = BACK[2:0];
+    (* ram_style = "block" *) reg [W-1:0] mem [0:7];
+    reg  [2:0] wp = 3'd0;
+    wire [2:0] ra = wp + RA_OFF;   // 3 bits: wraps (an index expression may not, in Icarus)
+    always @(posedge clk) begin
+        mem[wp] <= din;
+        wp <= wp + 3'd1;
+        dout <= mem[ra];
     end
 endmodule

@@ -98,13 +98,15 @@ static cbvh_f32 oracle_round(const mpq_t x, int up, int M, int X) {
 /* ---- the unit, from the spec, on rationals ------------------------------ */
 static int64_t key(cbvh_f32 x) { return cbvh_f32_key(x); }
 
+/* rcp +-0: a parallel axis, stepped with rho = 1 */
 static cbvh_f32 oracle_step(cbvh_f32 t, int sub, uint32_t c, int e, cbvh_f32 rcp, int up, int M, int X) {
     if (cbvh_f32_is_nan_or_inf(t)) return t;
     mpq_t x, y;
     mpq_inits(x, y, NULL);
     q_f32(x, t);
-    if (!cbvh_f32_is_zero(rcp)) {
-        q_f32(y, rcp);
+    {
+        if (cbvh_f32_is_zero(rcp)) mpq_set_ui(y, 1, 1);
+        else q_f32(y, rcp);
         mpq_t p;
         mpq_init(p);
         q_pow2(p, e);
@@ -125,15 +127,21 @@ static void oracle_unit(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray, const
     memset(o, 0, sizeof *o);
     cbvh_rbi_planes pl;
     cbvh_f32 tn = ray->tmin, tf = ray->tmax;
+    int outside = 0;
     for (int a = 0; a < 3; a++) {
-        int neg = (ray->rcp[a] >> 31) != 0;
+        int parallel = cbvh_f32_is_zero(ray->rcp[a]);
+        int neg = !parallel && (ray->rcp[a] >> 31) != 0;
         pl.t_lb[a] = oracle_step(par->t_lb[a], 0, ch[a].r, ch[a].e, ray->rcp[a], neg, p->mant, p->texp);
         pl.t_ub[a] = oracle_step(par->t_ub[a], 1, ch[a].sp, ch[a].e, ray->rcp[a], !neg, p->mant, p->texp);
+        if (parallel) { /* offsets: inside iff t_lb <= 0 <= t_ub */
+            if (key(pl.t_lb[a]) > 0 || key(pl.t_ub[a]) < 0) outside = 1;
+            continue;
+        }
         cbvh_f32 n = neg ? pl.t_ub[a] : pl.t_lb[a], f = neg ? pl.t_lb[a] : pl.t_ub[a];
         if (key(n) > key(tn)) tn = n;
         if (key(f) < key(tf)) tf = f;
     }
-    if (key(tn) > key(tf)) return;
+    if (outside || key(tn) > key(tf)) return;
     o->hit = 1;
     o->t_near = cbvh_f32_is_zero(tn) ? 0 : tn;
     o->t_far = cbvh_f32_is_zero(tf) ? 0 : tf;
@@ -280,9 +288,16 @@ static int run_oracle(long count) {
             CHECK(cbvh_rbi_anchor(&rr, &p, g, &an) == 0, "anchor status");
             for (int a = 0; a < 3; a++) {
                 int neg = (rr.d[a] >> 31) != 0;
-                if (cbvh_f32_is_zero(rr.d[a])) continue; /* the inside test: cases */
-                cbvh_f32 wl = oracle_anchor_plane(g[a].u, g[a].e, g[a].r, rr.o[a], rr.d[a], neg, M, X);
-                cbvh_f32 wu = oracle_anchor_plane(g[a].u, g[a].e, g[a].s, rr.o[a], rr.d[a], !neg, M, X);
+                cbvh_f32 dd = rr.d[a];
+                if (cbvh_f32_is_zero(dd)) dd = 0x3F800000u, neg = 0; /* d = 0: the offsets (plane - o) / 1 */
+                cbvh_f32 rc;
+                cbvh_rbi_reciprocal(dd, M, &rc);
+                if (cbvh_f32_is_zero(rc)) { /* |d| > 2^126: unconstrained */
+                    CHECK(an.t_lb[a] == CBVH_F32_NEG_INF && an.t_ub[a] == CBVH_F32_POS_INF, "anchor of a huge d");
+                    continue;
+                }
+                cbvh_f32 wl = oracle_anchor_plane(g[a].u, g[a].e, g[a].r, rr.o[a], dd, neg, M, X);
+                cbvh_f32 wu = oracle_anchor_plane(g[a].u, g[a].e, g[a].s, rr.o[a], dd, !neg, M, X);
                 CHECK(an.t_lb[a] == wl && an.t_ub[a] == wu, "anchor axis %d (M %d X %d): %08x %08x, oracle %08x %08x", a,
                       M, X, an.t_lb[a], an.t_ub[a], wl, wu);
             }
@@ -351,13 +366,19 @@ typedef struct {
 static void check_planes(const rbi_chain *c, const rbi_child *x) {
     /* every plane distance against the exact quotient rounded outward at 24 bits */
     for (int a = 0; a < 3; a++) {
-        if (cbvh_f32_is_zero(c->ray.d[a])) continue;
-        int neg = (c->ray.d[a] >> 31) != 0;
+        int parallel = cbvh_f32_is_zero(c->rr.rcp[a]);
+        if (parallel && !cbvh_f32_is_zero(c->ray.d[a])) { /* |d| > 2^126: unconstrained */
+            CHECK(x->inc.planes.t_lb[a] == CBVH_F32_NEG_INF && x->inc.planes.t_ub[a] == CBVH_F32_POS_INF,
+                  "%s: a huge direction's axis is not unconstrained", rbi_kind_names[c->kind]);
+            continue;
+        }
+        int neg = !parallel && (c->ray.d[a] >> 31) != 0; /* d = 0: offsets, plane - o over 1 */
         cbvh_xw u, st, pl, o, d, num;
         if (x->g[a].u == CBVH_F32_NEG_INF) cbvh_xw_from_int(&u, -1, 128);
         else cbvh_xw_from_f32(&u, x->g[a].u);
         cbvh_xw_from_f32(&o, c->ray.o[a]);
-        cbvh_xw_from_f32(&d, c->ray.d[a]);
+        if (parallel) cbvh_xw_from_int(&d, 1, 0);
+        else cbvh_xw_from_f32(&d, c->ray.d[a]);
         for (int w = 0; w < 2; w++) {
             cbvh_xw_from_int(&st, (int64_t)(w ? x->g[a].s : x->g[a].r), x->g[a].e);
             cbvh_xw_add(&pl, &u, &st);
@@ -509,7 +530,7 @@ static void run_cases(void) {
     CHECK(cbvh_rbi_anchor(&ray, &p, root, &T) == 0, "anchor");
     CHECK(T.t_lb[0] == F(1.0f) && T.t_ub[0] == F(17.0f), "anchor x: %08x %08x", T.t_lb[0], T.t_ub[0]);
     CHECK(T.t_lb[1] == F(10.0f) && T.t_ub[1] == F(2.0f), "anchor y (d < 0): %08x %08x", T.t_lb[1], T.t_ub[1]);
-    CHECK(T.t_lb[2] == CBVH_F32_NEG_INF && T.t_ub[2] == CBVH_F32_POS_INF, "anchor z (d = 0, inside)");
+    CHECK(T.t_lb[2] == F(-1.0f) && T.t_ub[2] == F(1.0f), "anchor z (d = 0: offsets -1 - 0, 1 - 0)");
     cbvh_rbi_axis ch[3] = {{-2, 4, 20}, {-1, 6, 2}, {-5, 7, 9}};
     cbvh_rbi_result res;
     CHECK(cbvh_ray_box_incr(&p, &rr, &T, ch, &res) == 0, "unit status");
@@ -518,7 +539,10 @@ static void run_cases(void) {
     CHECK(res.planes.t_lb[1] == F(8.5f) && res.planes.t_ub[1] == F(2.5f), "y planes %08x %08x", res.planes.t_lb[1],
           res.planes.t_ub[1]);
     CHECK(res.t_near == F(2.5f) && res.t_far == F(8.5f), "near/far %08x %08x", res.t_near, res.t_far);
-    CHECK(res.planes.t_lb[2] == CBVH_F32_NEG_INF && res.planes.t_ub[2] == CBVH_F32_POS_INF, "z stays unbounded");
+    CHECK(res.planes.t_lb[2] == F(-0.78125f) && res.planes.t_ub[2] == F(0.71875f), "z offsets -1 + 7/32, 1 - 9/32");
+    /* a parallel axis whose child lies beside the origin: a miss whatever the other axes give */
+    cbvh_rbi_axis chz[3] = {{-2, 4, 20}, {-1, 6, 2}, {-5, 40, 9}};
+    CHECK(cbvh_ray_box_incr(&p, &rr, &T, chz, &res) == 0 && !res.hit, "z: -1 + 40/32 > 0, the origin is below");
     /* rounding outward: rcp 1/3 at M 6 = 21/64; lb 1 + 1 21/64 = 85/64 -> 6 bits: 1.328125 exactly (85 = 1010101b,
        7 bits) -> RD to 6 bits: 84/64 = 1.3125; ub 17 - 21/64 = 16.671875 -> RU to 6 bits (ulp 1/2): 17 */
     cbvh_rbi_params p6 = {6, 6, 8};
@@ -531,10 +555,19 @@ static void run_cases(void) {
     /* d = 0 outside the root: (+Inf, -Inf) and every child misses */
     cbvh_ray rz = {{F(5.0f), 0, 0}, {0, F(1.0f), 0}, 0, CBVH_F32_POS_INF};
     cbvh_grid_axis rootz[3] = {{F(-1.0f), 0, 0, 2}, {F(-1.0f), 0, 0, 2}, {F(-1.0f), 0, 0, 2}};
-    CHECK(cbvh_rbi_anchor(&rz, &p, rootz, &T) == 0 && T.t_lb[0] == CBVH_F32_POS_INF && T.t_ub[0] == CBVH_F32_NEG_INF,
-          "d = 0 outside");
+    CHECK(cbvh_rbi_anchor(&rz, &p, rootz, &T) == 0 && T.t_lb[0] == F(-6.0f) && T.t_ub[0] == F(-4.0f),
+          "d = 0 outside: offsets -6, -4");
     rz.o[0] = F(1.0f); /* on the upper face: inside */
-    CHECK(cbvh_rbi_anchor(&rz, &p, rootz, &T) == 0 && T.t_lb[0] == CBVH_F32_NEG_INF, "d = 0 on the face: inside");
+    CHECK(cbvh_rbi_anchor(&rz, &p, rootz, &T) == 0 && T.t_lb[0] == F(-2.0f) && T.t_ub[0] == 0, "d = 0 on the face");
+    cbvh_rbi_ray rzr;
+    CHECK(cbvh_rbi_ray_setup(&rz, &p, &rzr) == 0 && rzr.rcp[0] == 0, "setup rz");
+    cbvh_rbi_axis cz[3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    CHECK(cbvh_ray_box_incr(&p, &rzr, &T, cz, &res) == 0 && res.hit, "on the upper face: a hit");
+    cz[0].sp = 1; /* the child's upper face one cell below the origin */
+    CHECK(cbvh_ray_box_incr(&p, &rzr, &T, cz, &res) == 0 && !res.hit, "one cell below: a miss");
+    rz.d[0] = 0x7F000001u; /* |d| > 2^126: unconstrained */
+    CHECK(cbvh_rbi_anchor(&rz, &p, rootz, &T) == 0 && T.t_lb[0] == CBVH_F32_NEG_INF && T.t_ub[0] == CBVH_F32_POS_INF,
+          "huge d: unconstrained");
     /* the tmin = -0 / +0 outputs */
     cbvh_rbi_ray rm = rr;
     rm.tmin = CBVH_F32_SIGN;

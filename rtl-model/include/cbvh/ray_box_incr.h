@@ -48,7 +48,9 @@ static inline int cbvh_rbi_emin(int texp) { return 2 - (1 << (texp - 1)); }
 
 /* A node's plane distances: per axis, the distance to its lower plane (t_lb)
  * and to its upper plane (t_ub), values of F(M, X).  For a ray with d_a > 0
- * (or d_a = +-0) the lower plane is the near one; for d_a < 0 the upper. */
+ * the lower plane is the near one; for d_a < 0 the upper.  On a parallel axis
+ * (reciprocal port +-0: d_a = +-0 or |d_a| > 2^126) they are the offsets
+ * lower - o_a and upper - o_a instead, and the box needs t_lb <= 0 <= t_ub. */
 typedef struct {
     cbvh_f32 t_lb[3], t_ub[3];
 } cbvh_rbi_planes;
@@ -89,8 +91,8 @@ uint32_t cbvh_rbi_ray_setup(const cbvh_ray *ray, const cbvh_rbi_params *p, cbvh_
 /* Per ray (§17.3), the anchor: the plane distances of the grid box `box` (as
  * the exact unit takes it: planes u + r 2^e and u + s 2^e), each the exact
  * quotient (plane - o) / d rounded once, outward, into F(M, X); for d_a = +-0
- * (-Inf, +Inf) when o_a lies in [lower, upper] (faces included), else
- * (+Inf, -Inf).  Status and rejects as cbvh_ray_box's (the ray, then the
+ * the offsets RD_F(lower - o_a), RU_F(upper - o_a); for |d_a| > 2^126
+ * (-Inf, +Inf).  Status and rejects as cbvh_ray_box's (the ray, then the
  * box's NAN_INF, BAD_SCALE, BAD_CODE, INVERTED; M, X and N as
  * cbvh_rbi_params_check); every output +0 on a reject. */
 uint32_t cbvh_rbi_anchor(const cbvh_ray *ray, const cbvh_rbi_params *p, const cbvh_grid_axis box[3],

@@ -59,8 +59,9 @@
 #endif
 
 typedef struct {
-    double rho[3];         /* the reciprocal ports' values (a -0 port as -0.0) */
-    int up_lb[3];          /* the lower plane rounds up (RU_F): the port's sign bit */
+    double rho[3];         /* the reciprocal ports' values; 1 on a parallel axis (port +-0) */
+    int up_lb[3];          /* the lower plane rounds up (RU_F): the port's sign bit, 0 on a parallel axis */
+    int par[3], any_par;   /* parallel axes: offsets, inside iff t_lb <= 0 <= t_ub */
     double tmin;
     uint64_t mask, unit;   /* low 53 - M bits; one M-bit unit, on binary64 bits */
     uint64_t emin_b, emax_b; /* biased binary64 exponents of 2^emin and 2^emax */
@@ -93,9 +94,12 @@ static inline cbvh_f32 cbvh_rbi_f(double x) { return x == 0 ? 0u : cbvh_f32_of((
 
 static inline void cbvh_rbi_fprep(const cbvh_rbi_params *p, const cbvh_rbi_ray *r, cbvh_rbi_fray *f) {
     int M = p->mant, emin = cbvh_rbi_emin(p->texp), emax = cbvh_rbi_emax(p->texp);
+    f->any_par = 0;
     for (int a = 0; a < 3; a++) {
-        f->rho[a] = cbvh_rbi_d(r->rcp[a]);
-        f->up_lb[a] = (int)(r->rcp[a] >> 31);
+        f->par[a] = cbvh_f32_is_zero(r->rcp[a]);
+        f->any_par |= f->par[a];
+        f->rho[a] = f->par[a] ? 1.0 : cbvh_rbi_d(r->rcp[a]);
+        f->up_lb[a] = f->par[a] ? 0 : (int)(r->rcp[a] >> 31);
     }
     f->tmin = cbvh_rbi_d(r->tmin);
     f->unit = UINT64_C(1) << (53 - M);
@@ -195,6 +199,10 @@ static inline int cbvh_rbi_ftest1(const cbvh_rbi_fray *f, double tmax, const cbv
         double ub = cbvh_rbi_fstep(f, n->t[a][1], -((double)sp[a] * n->se[a]), up ^ 1u);
         ch->t[a][0] = lb;
         ch->t[a][1] = ub;
+        if (f->par[a]) {
+            if (lb > 0 || ub < 0) return 0;
+            continue;
+        }
         double nn = up ? ub : lb, fa = up ? lb : ub;
         tn = nn > tn ? nn : tn;
         tf = fa < tf ? fa : tf;
@@ -210,6 +218,7 @@ static inline int cbvh_rbi_ftest(const cbvh_rbi_fray *f, double tmax, const cbvh
 #if CBVH_RBI_SSE2
     /* lanes (near, -far): one max accumulates both t_near and t_far; a box
      * with a special lane is redone one plane at a time */
+    if (f->any_par) return cbvh_rbi_ftest1(f, tmax, n, r, sp, ch, t_near, t_far); /* axis-parallel rays */
     __m128d acc = _mm_set_pd(-tmax, f->tmin), neg1 = _mm_set_pd(-0.0, 0.0);
     int special = 0;
     for (int a = 0; a < 3; a++) {

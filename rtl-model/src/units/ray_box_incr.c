@@ -3,7 +3,8 @@
  *
  * Per ray and axis a, rho_a = the reciprocal port: sign(d_a) x RZ_M(1/|d_a|)
  * (truncated to M significant bits), clamped to (2^M - 1) 2^(128-M) when
- * 1/|d_a| >= 2^128, and 0 when d_a = +-0 or |d_a| > 2^126 (§17.2).  Per child
+ * 1/|d_a| >= 2^128, and +-0 when d_a = +-0 or |d_a| > 2^126: the axis is
+ * then parallel (below) (§17.2).  Per child
  * and axis, with the parent's plane distances T_lb, T_ub (values of the
  * format F(M, X), §17.1), the parent's child-grid scale e and the child's
  * codes r (from the parent's lower plane) and s' (from its upper plane):
@@ -39,10 +40,14 @@
  * from the parent's *upper* plane (seed 003, Sec. 3): from the lower plane,
  * t(H) = t(Lp) + s 2^e / d_a would need an upper bound of t(Lp), which the
  * parent carries only as a lower bound.
- * d_a = +-0: the anchor gives (-Inf, +Inf) when o_a lies in the root's slab
- * (faces included) and (+Inf, -Inf) otherwise, and rho = 0 keeps them; a box
- * the exact unit accepts has o_a in its slab, inside the root's, so the axis
- * puts no constraint on it.
+ * A parallel axis (the port is +-0: d_a = +-0, or |d_a| > 2^126): the
+ * distances are spatial offsets lower - o_a and upper - o_a instead, stepped
+ * with rho = 1 exactly (the same lines with 1/d_a replaced by 1: the lower
+ * offset rounds down, the upper up), and the axis passes iff
+ * T_lb' <= 0 <= T_ub'.  By the same induction T_lb <= L - o_a and
+ * T_ub >= H - o_a, so a box the exact unit accepts (L <= o_a <= H) passes.
+ * For |d_a| > 2^126 the anchor gives (-Inf, +Inf): no constraint at all,
+ * which is conservative for any ray.
  * Then near_a <= the exact near distance n_a and far_a >= f_a on every axis,
  * max and min are monotone, and [t_near, t_far] contains the exact interval
  * [max(tmin, n_a), min(tmax, f_a)]: if the real-number slab test hits, so
@@ -195,15 +200,17 @@ uint32_t cbvh_rbi_anchor(const cbvh_ray *ray, const cbvh_rbi_params *p, const cb
         cbvh_xw_from_int(&step, (int64_t)box[a].s, box[a].e);
         cbvh_xw_add(&hi, &u, &step);
         cbvh_xw_from_f32(&o, ray->o[a]);
-        if (cbvh_f32_is_zero(ray->d[a])) {
-            int inside = cbvh_xw_cmp(&lo, &o) <= 0 && cbvh_xw_cmp(&o, &hi) <= 0;
-            out->t_lb[a] = inside ? CBVH_F32_NEG_INF : CBVH_F32_POS_INF;
-            out->t_ub[a] = inside ? CBVH_F32_POS_INF : CBVH_F32_NEG_INF;
+        cbvh_f32 rc;
+        cbvh_rbi_reciprocal(ray->d[a], p->mant, &rc);
+        if (cbvh_f32_is_zero(rc) && !cbvh_f32_is_zero(ray->d[a])) { /* |d| > 2^126: parallel, unconstrained */
+            out->t_lb[a] = CBVH_F32_NEG_INF;
+            out->t_ub[a] = CBVH_F32_POS_INF;
             continue;
         }
-        int neg = (ray->d[a] & CBVH_F32_SIGN) != 0;
+        int neg = (ray->d[a] & CBVH_F32_SIGN) != 0 && !cbvh_f32_is_zero(ray->d[a]);
         cbvh_rnd m_lb = neg ? CBVH_RND_UP : CBVH_RND_DOWN, m_ub = neg ? CBVH_RND_DOWN : CBVH_RND_UP;
-        cbvh_xw_from_f32(&d, ray->d[a]);
+        if (cbvh_f32_is_zero(ray->d[a])) cbvh_xw_from_int(&d, 1, 0); /* d = 0: offsets lower - o, upper - o */
+        else cbvh_xw_from_f32(&d, ray->d[a]);
         cbvh_xw_sub(&num, &lo, &o);
         out->t_lb[a] = round_f32(cbvh_xw_div_round(&num, &d, p->mant, m_lb), m_lb, p->mant, p->texp);
         cbvh_xw_sub(&num, &hi, &o);
@@ -298,23 +305,29 @@ uint32_t cbvh_ray_box_incr_int(const cbvh_rbi_params *p, const cbvh_rbi_ray *ray
     int64_t kn = cbvh_f32_key(ray->tmin), kf = cbvh_f32_key(ray->tmax);
     cbvh_f32 tn = ray->tmin, tf = ray->tmax;
     cbvh_rbi_planes pl;
+    int outside = 0;
     for (int a = 0; a < 3; a++) {
         cbvh_f32 rc = ray->rcp[a];
-        int rneg = (rc & CBVH_F32_SIGN) != 0;
-        uint64_t rsig = 0; /* rho = rsig 2^rexp, rsig < 2^M */
-        int rexp = 0;
-        if (!cbvh_f32_is_zero(rc)) {
+        int par = cbvh_f32_is_zero(rc); /* a parallel axis: distances are offsets, rho = 1 */
+        int rneg = !par && (rc & CBVH_F32_SIGN) != 0;
+        uint64_t rsig = UINT64_C(1) << (M - 1); /* rho = rsig 2^rexp, rsig < 2^M */
+        int rexp = -(M - 1);
+        if (!par) {
             rsig = ((rc & CBVH_F32_FRAC) | 0x800000u) >> (24 - M);
             rexp = (int)((rc >> 23) & 0xFFu) - 127 - (M - 1);
         }
         cbvh_rnd m_lb = rneg ? CBVH_RND_UP : CBVH_RND_DOWN, m_ub = rneg ? CBVH_RND_DOWN : CBVH_RND_UP;
         pl.t_lb[a] = add_round(parent->t_lb[a], rneg, child[a].r * rsig, child[a].e + rexp, m_lb, M, X);
         pl.t_ub[a] = add_round(parent->t_ub[a], !rneg, child[a].sp * rsig, child[a].e + rexp, m_ub, M, X);
+        if (par) { /* inside iff lower - o <= 0 <= upper - o */
+            outside |= cbvh_f32_key(pl.t_lb[a]) > 0 || cbvh_f32_key(pl.t_ub[a]) < 0;
+            continue;
+        }
         cbvh_f32 n = rneg ? pl.t_ub[a] : pl.t_lb[a], f = rneg ? pl.t_lb[a] : pl.t_ub[a];
         if (cbvh_f32_key(n) > kn) kn = cbvh_f32_key(n), tn = n;
         if (cbvh_f32_key(f) < kf) kf = cbvh_f32_key(f), tf = f;
     }
-    if (kn > kf) return 0;
+    if (outside || kn > kf) return 0;
     out->hit = 1;
     out->t_near = cbvh_f32_is_zero(tn) ? 0u : tn;
     out->t_far = cbvh_f32_is_zero(tf) ? 0u : tf;
