@@ -35,11 +35,10 @@ static long fails;
 static void run_tree(const char *what, const cbvh_tree *t, const cbvh_scene *s, const cbvh_ray *rays,
                      const cbvh_trav_hit *ref, const int *ref_any, int nrays, int M, int X, int print) {
     cbvh_trav_stats st = {0}, ex = {0};
-    cbvh_incr_stats is = {0};
     long diff = 0, adiff = 0, hits = 0;
     for (int i = 0; i < nrays; i++) {
         cbvh_trav_hit h, he;
-        int rc = cbvh_trace_cbvh_incr(t, s->tris, &rays[i], M, X, CBVH_TRAV_CLOSEST, &h, &st, &is);
+        int rc = cbvh_trace_cbvh_incr(t, s->tris, &rays[i], M, X, CBVH_TRAV_CLOSEST, &h, &st);
         CHECK(rc == 0, "%s M %d X %d ray %d: rc %d", what, M, X, i, rc);
         if (!same_hit(&h, &ref[i])) {
             if (diff++ < 3)
@@ -48,24 +47,23 @@ static void run_tree(const char *what, const cbvh_tree *t, const cbvh_scene *s, 
         }
         hits += h.hit;
         cbvh_trav_stats sa = {0};
-        cbvh_incr_stats ia = {0};
-        rc = cbvh_trace_cbvh_incr(t, s->tris, &rays[i], M, X, CBVH_TRAV_ANY, &h, &sa, &ia);
+        rc = cbvh_trace_cbvh_incr(t, s->tris, &rays[i], M, X, CBVH_TRAV_ANY, &h, &sa);
         if (rc != 0 || h.hit != ref_any[i]) adiff++;
         if (print) cbvh_trace_cbvh(t, s->tris, &rays[i], M, CBVH_TRAV_CLOSEST, &he, &ex);
     }
     CHECK(diff == 0 && adiff == 0, "%s M %d X %d: %ld closest and %ld any hits differ from the float BVH's", what, M, X,
           diff, adiff);
-    CHECK(is.fp_box_hits <= st.box_tests && is.fp_tri_tests <= st.tri_tests, "%s: counters out of range", what);
+    CHECK(st.fp_box_hits <= st.box_tests && st.fp_tri_tests <= st.tri_tests, "%s: counters out of range", what);
     if (M == 24 && X == 8 && st.box_tests > 1000 && strncmp(what, "soup", 4) != 0) /* scenes of moderate extent */
-        CHECK(is.fp_box_hits * 50 < st.box_tests, "%s M 24: %llu false-positive box hits of %llu tests", what,
-              (unsigned long long)is.fp_box_hits, (unsigned long long)st.box_tests);
+        CHECK(st.fp_box_hits * 50 < st.box_tests, "%s M 24: %llu false-positive box hits of %llu tests", what,
+              (unsigned long long)st.fp_box_hits, (unsigned long long)st.box_tests);
     if (print)
         printf("%-28s M %2d: hits %4ld  box tests %8llu (exact unit: %8llu, x%.3f)  false-positive hits %7llu  "
                "triangle tests %8llu (exact: %8llu, x%.3f), %7llu of them under a false positive\n",
                what, M, hits, (unsigned long long)st.box_tests, (unsigned long long)ex.box_tests,
-               (double)st.box_tests / (double)(ex.box_tests ? ex.box_tests : 1), (unsigned long long)is.fp_box_hits,
+               (double)st.box_tests / (double)(ex.box_tests ? ex.box_tests : 1), (unsigned long long)st.fp_box_hits,
                (unsigned long long)st.tri_tests, (unsigned long long)ex.tri_tests,
-               (double)st.tri_tests / (double)(ex.tri_tests ? ex.tri_tests : 1), (unsigned long long)is.fp_tri_tests);
+               (double)st.tri_tests / (double)(ex.tri_tests ? ex.tri_tests : 1), (unsigned long long)st.fp_tri_tests);
 }
 
 static void run_scene(cbvh_scene *s, const char *name, int lbvh, int min_scale, int all_n) {

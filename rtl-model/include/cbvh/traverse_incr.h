@@ -12,20 +12,13 @@
 #include "cbvh/ray_box_incr.h"
 #include "cbvh/traverse.h"
 
-/* What the incremental unit costs a traversal, beside cbvh_trav_stats (added
- * to, not cleared). */
-typedef struct {
-    uint64_t fp_box_hits;  /* children it hits that the exact unit (unit 6, same M) misses */
-    uint64_t fp_tri_tests; /* triangle tests in leaves reached through such a child */
-    uint64_t anchors;      /* nodes whose distances were derived afresh (cbvh_rbi_anchor): the root,
-                              and a child that reaches past its parent's upper plane (s' < 0) */
-} cbvh_incr_stats;
-
 /* cbvh_trace_cbvh with the incremental unit at M = mant_bits, X = texp (the
  * root's float box still goes through unit 6 at M, as in cbvh_trace_cbvh).
- * 0, or -1 (a ray the units reject, a bad M or X, a stack overflow, a decode
- * error or pointer cycle): no hit. */
+ * The counters are added to *st, with its fp_box_hits (children unit 10 hits
+ * that unit 6 at the same M misses) and fp_tri_tests (triangle tests in
+ * leaves reached through such a child).  0, or -1 (a ray the units reject, a
+ * bad M or X, a stack overflow, a decode error or pointer cycle): no hit. */
 int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits, int texp,
-                         cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st, cbvh_incr_stats *is);
+                         cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st);
 
 #endif

@@ -15,8 +15,8 @@
  * kept, because the unit contains the exact interval (§17.5) and the culling
  * bound is §5's.  The counters: box_tests counts the incremental unit's
  * tests; each hit is also tested by unit 6 at the same M, and a child it
- * misses counts in fp_box_hits and marks the subtree: the triangle tests of
- * its leaves count in fp_tri_tests. */
+ * misses counts in st->fp_box_hits and marks the subtree: the triangle tests
+ * of its leaves count in st->fp_tri_tests. */
 #include "cbvh/traverse_incr.h"
 
 #include "fast/decode_fast.h"
@@ -94,7 +94,7 @@ static int root_extent(const cbvh_tree *t, uint32_t S[3]) {
 }
 
 int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ray, int mant_bits, int texp,
-                         cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st, cbvh_incr_stats *is) {
+                         cbvh_trav_mode mode, cbvh_trav_hit *hit, cbvh_trav_stats *st) {
     trav_state ts;
     if (trav_begin(&ts, hit, ray, mant_bits, tris, mode, (uint64_t)t->npairs * t->pair_bytes, t->nids)) return -1;
     const cbvh_params *prm = &t->params;
@@ -107,7 +107,7 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
     cbvh_rbf_prepare(ray, mant_bits, &fp);
     int fast_codec = CBVH_FAST_PATHS && cbvh_fast_params_ok(prm) &&
                      t->pair_bytes == cbvh_nodepair_bytes(prm->quant_bits);
-    uint64_t fp_box = 0, fp_tri = 0, anchors = 0;
+    uint64_t fp_box = 0, fp_tri = 0;
 
     entry stack[CBVH_TRAV_STACK];
     int sp = 0;
@@ -123,7 +123,6 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
         double tn0;
         int h0 = anchor_test(ray, &p, &rr, &f, cull_d, g, &e->n, &tn0);
         if (h0 < 0) return -1;
-        anchors++;
         e->leaf = 0;
         e->fp = 0;
         e->ptr = t->root_pair;
@@ -145,7 +144,7 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
         /* a tree visits each pair at most once per ray: more is a pointer cycle */
         if (e->ptr >= t->npairs || ts.s.nodes >= t->npairs) return -1;
         ts.s.nodes++;
-        trav_fetch(&ts, (uint64_t)e->ptr * t->pair_bytes, t->pair_bytes);
+        trav_fetch(&ts, CBVH_FETCH_NODE, (uint64_t)e->ptr * t->pair_bytes, t->pair_bytes);
         const uint8_t *pair = t->pairs + (size_t)e->ptr * t->pair_bytes;
         entry node = *e; /* e's slot is reused by the pushes below */
         for (int a = 0; a < 3; a++) node.n.se[a] = cbvh_rbi_pow2(node.ctx.axis[a].scale) * f.rho[a];
@@ -185,7 +184,6 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
             } else { /* past the parent's upper plane: the child's distances afresh */
                 h[c] = anchor_test(ray, &p, &rr, &f, cull_d, g, &kid[c].n, &kid[c].t_near);
                 if (h[c] < 0) return -1;
-                anchors++;
             }
             if (!h[c]) continue;
             cbvh_box_result r;
@@ -212,8 +210,7 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
     }
     ts.s.max_stack = max_stack;
     trav_finish(&ts, hit, st);
-    is->fp_box_hits += fp_box;
-    is->fp_tri_tests += fp_tri;
-    is->anchors += anchors;
+    st->fp_box_hits += fp_box;
+    st->fp_tri_tests += fp_tri;
     return 0;
 }
