@@ -23,7 +23,7 @@
  *                rounding steps add up to along the chain (median, p99)
  * 2. Throughput on one core: box tests/s of cbvh_ray_box_incr against the
  *    exact unit, cbvh_ray_box (and with its ray prepared once, as the
- *    traversals call it), on the same 65,536 recorded children (N = 6, M = 8),
+ *    traversals call it), on the same 16,384 recorded children (N = 6, M = 8),
  *    R repetitions (default 7) of about 0.2 s of this thread's CPU time each:
  *    min / median / max.
  * The false-positive check is also an assertion: a child the exact unit hits

@@ -139,14 +139,7 @@ module cbvh_ray_box_incr #(
 
     // binary32 value order as an unsigned key: -0 and +0 get one key, and
     // unkey(key(f)) is f with -0 made +0 (the outputs' canonical zero)
-    function [31:0] fkey;
-        input [31:0] f;
-        begin
-            if (f[30:0] == 31'd0) fkey = 32'h80000000;
-            else if (f[31])       fkey = ~f;
-            else                  fkey = {1'b1, f[30:0]};
-        end
-    endfunction
+    function [31:0] fkey; input [31:0] f; fkey = f[30:0] == 31'd0 ? 32'h80000000 : f[31] ? ~f : {1'b1, f[30:0]}; endfunction
     function [31:0] unkey; input [31:0] k; unkey = k[31] ? {1'b0, k[30:0]} : ~k; endfunction
 
     // valid and phase beside the datapaths in flip-flops; status, the keys of

@@ -42,6 +42,7 @@
 
 #include "cbvh/ray_box_incr.h"
 #include "fast/fast_paths.h"
+#include "fast/ray_box_f64.h" /* cbvh_rbf_bits, cbvh_rbf_from_bits, cbvh_rbf_pow2 */
 
 #if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0 && CBVH_FAST_PATHS
 #define CBVH_RBI_FAST 1
@@ -78,16 +79,6 @@ typedef struct {
     double se[3];
 } cbvh_rbi_fnode;
 
-static inline uint64_t cbvh_rbi_dbits(double x) {
-    uint64_t b;
-    memcpy(&b, &x, sizeof b);
-    return b;
-}
-static inline double cbvh_rbi_dfrom(uint64_t b) {
-    double x;
-    memcpy(&x, &b, sizeof x);
-    return x;
-}
 static inline double cbvh_rbi_d(cbvh_f32 b) { return (double)cbvh_float_of(b); }
 /* exact for the values it is given (binary32 values); -0 -> +0 */
 static inline cbvh_f32 cbvh_rbi_f(double x) { return x == 0 ? 0u : cbvh_f32_of((float)x); }
@@ -108,16 +99,13 @@ static inline void cbvh_rbi_fprep(const cbvh_rbi_params *p, const cbvh_rbi_ray *
     f->emax_b = (uint64_t)(emax + 1023);
     f->min_bits = f->emin_b << 52;
     f->max_bits = (f->emax_b << 52) | ((UINT64_C(1) << 52) - f->unit);
-    f->lo = cbvh_rbi_dfrom(f->min_bits);
-    f->hi = cbvh_rbi_dfrom((f->emax_b + 1u) << 52);
+    f->lo = cbvh_rbf_from_bits(f->min_bits);
+    f->hi = cbvh_rbf_from_bits((f->emax_b + 1u) << 52);
     for (int a = 0; a < 3; a++) {
         f->up2[a][0] = f->up_lb[a] ? ~UINT64_C(0) : 0u;
         f->up2[a][1] = ~f->up2[a][0];
     }
 }
-
-/* 2^e as a binary64, e in [-1022, 1023]. */
-static inline double cbvh_rbi_pow2(int e) { return cbvh_rbi_dfrom((uint64_t)(e + 1023) << 52); }
 
 /* The node with plane distances pl and child grid scales e[3] (in [-126, 126]). */
 static inline void cbvh_rbi_fnode_of(const cbvh_rbi_fray *f, const cbvh_rbi_planes *pl, const int e[3],
@@ -125,7 +113,7 @@ static inline void cbvh_rbi_fnode_of(const cbvh_rbi_fray *f, const cbvh_rbi_plan
     for (int a = 0; a < 3; a++) {
         n->t[a][0] = cbvh_rbi_d(pl->t_lb[a]);
         n->t[a][1] = cbvh_rbi_d(pl->t_ub[a]);
-        n->se[a] = cbvh_rbi_pow2(e[a]) * f->rho[a];
+        n->se[a] = cbvh_rbf_pow2(e[a]) * f->rho[a];
     }
 }
 
@@ -139,7 +127,7 @@ static inline double cbvh_rbi_fstep(const cbvh_rbi_fray *f, double t, double i, 
     if (!(t - t == 0)) return t; /* +-Inf + finite */
     double s = t + i, bb = s - t;
     double err = (t - (s - bb)) + (i - bb);
-    uint64_t b = cbvh_rbi_dbits(s), eb = cbvh_rbi_dbits(err);
+    uint64_t b = cbvh_rbf_bits(s), eb = cbvh_rbf_bits(err);
     uint64_t sign = b & (UINT64_C(1) << 63), mag = b ^ sign;
     uint64_t enz = (eb << 1) != 0;                  /* err != 0 */
     uint64_t eopp = enz & ((eb ^ b) >> 63);        /* ... and of the other sign than s */
@@ -155,7 +143,7 @@ static inline double cbvh_rbi_fstep(const cbvh_rbi_fray *f, double t, double i, 
         else r = away ? UINT64_C(0x7FF0000000000000) : f->max_bits;
         if (r == 0) return 0.0;
     }
-    return cbvh_rbi_dfrom(r | sign);
+    return cbvh_rbf_from_bits(r | sign);
 }
 
 #if CBVH_RBI_SSE2

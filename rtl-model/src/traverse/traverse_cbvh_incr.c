@@ -141,13 +141,10 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
             if (done) break;
             continue;
         }
-        /* a tree visits each pair at most once per ray: more is a pointer cycle */
-        if (e->ptr >= t->npairs || ts.s.nodes >= t->npairs) return -1;
-        ts.s.nodes++;
-        trav_fetch(&ts, CBVH_FETCH_NODE, (uint64_t)e->ptr * t->pair_bytes, t->pair_bytes);
-        const uint8_t *pair = t->pairs + (size_t)e->ptr * t->pair_bytes;
+        const uint8_t *pair = trav_cbvh_pair(&ts, t, e->ptr);
+        if (!pair) return -1;
         entry node = *e; /* e's slot is reused by the pushes below */
-        for (int a = 0; a < 3; a++) node.n.se[a] = cbvh_rbi_pow2(node.ctx.axis[a].scale) * f.rho[a];
+        for (int a = 0; a < 3; a++) node.n.se[a] = cbvh_rbf_pow2(node.ctx.axis[a].scale) * f.rho[a];
         cbvh_fast_child fc[2];
         uint32_t ppm[3];
         int fast = fast_codec && cbvh_fast_pair_decode_valid(prm, t->enc, &node.ctx, pair, fc, ppm);
