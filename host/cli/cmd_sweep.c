@@ -33,7 +33,7 @@ static void usage(FILE *f) {
             "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
             "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,F...]]\n"
             "                        [--one-sided] [--cache KB...] [--reps K] [--cost-table DIR]\n"
-            "                        [--timing K=V,...]\n"
+            "                        [--timing K=V,...] [--box-unit U]\n"
             "  SCENE is a scene file (.scene, .json) or a mesh file / proc:NAME (its default scene,\n"
             "  docs/scenes.md).\n"
             "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
@@ -56,6 +56,9 @@ static void usage(FILE *f) {
             "                    bounding-sphere hierarchy, docs/tlist.md; default 6 lists, earliest first)\n"
             "  --one-sided       triangles count only from their front side (counter-clockwise), on every\n"
             "                    format; needed by tlist:...:cull (back-face culling)\n"
+            "  --box-unit U      the CBVH rows' box unit: exact (unit 6, default) or incremental[:X] (unit 10,\n"
+            "                    Eq. 5 with X-bit distance exponents, 3..8, default 8; adds its false-positive\n"
+            "                    box hits and the triangle tests under them per setting)\n"
             "  --cache KB...     node and triangle cache sizes the timing model runs, each in KB (0 = no\n"
             "                    cache, inf = infinite), at most %d (default 64; docs/timing_model.md)\n"
             "  --reps K          timed repetitions for the CPU-time column, 1..%d (default 5): the median\n"
@@ -388,6 +391,7 @@ enum {
     OPT_REPS,
     OPT_COST_TABLE,
     OPT_TIMING,
+    OPT_BOX_UNIT,
     OPT_TEST_CORRUPT
 };
 
@@ -594,6 +598,7 @@ static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli
     case OPT_FORMATS:
         if (list_again("--formats", &c->formats_given)) return -1;
         return parse_formats(v, o);
+    case OPT_BOX_UNIT: return cbvh_parse_box_unit("cbvh sweep", v, &o->box_unit, &o->texp);
     case OPT_CACHE:
         if (list_again("--cache", &c->cache_given)) return -1;
         return parse_caches(v, argc, argv, o);
@@ -626,6 +631,7 @@ static int parse_options(int argc, char **argv, sweep_cli *c) {
                                        {"heatmap", required_argument, 0, OPT_HEATMAP},
                                        {"one-sided", no_argument, 0, OPT_ONE_SIDED},
                                        {"formats", required_argument, 0, OPT_FORMATS},
+                                       {"box-unit", required_argument, 0, OPT_BOX_UNIT},
                                        {"cache", required_argument, 0, OPT_CACHE},
                                        {"reps", required_argument, 0, OPT_REPS},
                                        {"cost-table", required_argument, 0, OPT_COST_TABLE},
@@ -633,7 +639,8 @@ static int parse_options(int argc, char **argv, sweep_cli *c) {
                                        {"test-corrupt", required_argument, 0, OPT_TEST_CORRUPT},
                                        {0, 0, 0, 0}};
     memset(c, 0, sizeof *c);
-    c->run = (cbvh_sweep_opts){.bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1, .reps = 5};
+    c->run = (cbvh_sweep_opts){
+        .bits_lo = 3, .bits_hi = 10, .corrupt_setting = -1, .reps = 5, .texp = CBVH_RBI_TEXP_DEFAULT};
     c->cost_dir = cbvh_cost_dir();
     c->knee_pct = 10;
     int opt;
@@ -1171,6 +1178,10 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
     cJSON_AddNumberToObject(root, "spp", res->spp);
     cJSON_AddNumberToObject(root, "frames", res->frames);
     cJSON_AddNumberToObject(root, "rays", (double)res->ref_rays);
+    if (c->run.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) {
+        cJSON_AddStringToObject(root, "box_unit", "incremental");
+        cJSON_AddNumberToObject(root, "texp", c->run.texp);
+    }
     json_machine(root, c, f);
     cJSON *fl = cJSON_AddObjectToObject(root, "float");
     cJSON_AddNumberToObject(fl, "node_bytes", (double)res->ref.r.node_bytes);
@@ -1185,6 +1196,11 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         cJSON_AddNumberToObject(row, "node_bytes", (double)r->r.node_bytes);
         cJSON_AddBoolToObject(row, "same_hits", r->same);
         if (!r->same) cJSON_AddStringToObject(row, "first_difference", r->why);
+        if (c->run.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) { /* totals over the effects */
+            cbvh_fx_stats t = cbvh_fx_total(&r->r);
+            cJSON_AddNumberToObject(row, "fp_box_hits", (double)t.st.fp_box_hits);
+            cJSON_AddNumberToObject(row, "fp_tri_tests", (double)t.st.fp_tri_tests);
+        }
         json_effects(row, d, f, 1 + i);
         cJSON_AddItemToArray(rows, row);
     }
@@ -1319,6 +1335,19 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         cbvh_fx_stats t = cbvh_fx_total(&r->r);
         text_row(name, "total", &t, &f->ftot, r->r.node_bytes, res->ref.r.node_bytes, &f->cm[k].mc[0],
                  &f->cm[0].mc[0], same);
+    }
+    if (c->run.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) {
+        printf("\nincremental box unit (X=%d) on the CBVH rows: false-positive box hits per ray (share of its box "
+               "tests: unit 6 at the same M rejects them), triangle tests under them per ray (share), totals:\n",
+               c->run.texp);
+        for (int i = 0; i < res->nrows; i++) {
+            cbvh_fx_stats t = cbvh_fx_total(&res->rows[i].r);
+            double n = t.rays ? (double)t.rays : 1.0;
+            printf("  N=%d M=%d E=%d: %.2f (%.1f%%), %.2f (%.1f%%)\n", res->rows[i].s.bits, res->rows[i].s.mant,
+                   res->rows[i].s.min_scale, (double)t.st.fp_box_hits / n,
+                   100.0 * cbvh_ratio((double)t.st.fp_box_hits, (double)t.st.box_tests),
+                   (double)t.st.fp_tri_tests / n, 100.0 * cbvh_ratio((double)t.st.fp_tri_tests, (double)t.st.tri_tests));
+        }
     }
     printf("\nnode memory: float BVH %llu B", (unsigned long long)res->ref.r.node_bytes);
     for (int b = 0; b < nb; b++)

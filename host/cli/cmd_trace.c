@@ -24,7 +24,7 @@
 static void usage(FILE *f) {
     size_t n;
     const cbvh_format *const *fmts = cbvh_formats(&n);
-    fprintf(f, "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--format ");
+    fprintf(f, "usage: cbvh trace SCENE [--bits N] [--mant M] [--min-scale E] [--box-unit U] [--format ");
     for (size_t i = 0; i < n; i++)
         fprintf(f, "%s%s%s", i ? "|" : "", fmts[i]->name, fmts[i]->flags & CBVH_FORMAT_OPTIONS ? "..." : "");
     fprintf(f,
@@ -40,9 +40,13 @@ static void usage(FILE *f) {
             "  also each relative to the float BVH on the same rays, and a units-active line.\n"
             "  --bits N       CBVH coordinate bits, %d..%d (default %d)\n"
             "  --mant M       mantissa bits of the ray-box unit, %d..%d (default 24)\n"
-            "  --min-scale E  minimum grid scale, %d..%d (default %d)\n",
+            "  --min-scale E  minimum grid scale, %d..%d (default %d)\n"
+            "  --box-unit U   exact (unit 6: each plane distance exact, rounded once; default) or\n"
+            "                 incremental[:X] (unit 10: Eq. 5 from the parent's distances, M-bit\n"
+            "                 reciprocal and distances with X exponent bits, %d..%d, default %d; counts\n"
+            "                 its false-positive box hits and the triangle tests under them); cbvh only\n",
             CBVH_N_MIN, CBVH_N_MAX, CBVH_N_DEFAULT, CBVH_MANT_MIN, CBVH_MANT_MAX, CBVH_SCALE_FLOOR, CBVH_SCALE_CEIL,
-            CBVH_MIN_SCALE_DEFAULT);
+            CBVH_MIN_SCALE_DEFAULT, CBVH_RBI_TEXP_MIN, CBVH_RBI_TEXP_MAX, CBVH_RBI_TEXP_DEFAULT);
     /* One line (or more) per format: its help, continued lines indented. */
     for (size_t i = 0; i < n; i++) {
         fprintf(f, "%s", i ? "                 " : "  --format F     ");
@@ -109,7 +113,7 @@ static void json_g6(cJSON *o, const char *key, double v) {
 
 static void json_count(cJSON *o, const char *key, uint64_t v) { cJSON_AddNumberToObject(o, key, (double)v); }
 
-static cJSON *json_stats(const cbvh_fx_stats *s, const cbvh_machine *mc) {
+static cJSON *json_stats(const cbvh_fx_stats *s, const cbvh_machine *mc, int incremental) {
     cbvh_ray_metrics p = metrics(s, mc);
     cJSON *o = cJSON_CreateObject();
     json_count(o, "rays", s->rays);
@@ -130,6 +134,10 @@ static cJSON *json_stats(const cbvh_fx_stats *s, const cbvh_machine *mc) {
     json_g6(o, "cpu_us_per_ray", p.cpu_us);
     json_g6(o, "cpu_us_per_ray_min", p.cpu_lo);
     json_g6(o, "cpu_us_per_ray_max", p.cpu_hi);
+    if (incremental) {
+        json_count(o, "fp_box_hits", s->st.fp_box_hits);
+        json_count(o, "fp_tri_tests", s->st.fp_tri_tests);
+    }
     return o;
 }
 
@@ -144,16 +152,17 @@ static void unit_counts(const cbvh_unit_activity *u, uint64_t v[NUNITS]) {
 }
 
 static void json_result(cJSON *root, const char *key, const cbvh_scene_desc *d, const cbvh_fx_result *r,
-                        const cbvh_machine *mc) {
+                        const cbvh_machine *mc, int incremental) {
     cJSON *o = cJSON_AddObjectToObject(root, key);
     json_count(o, "node_bytes", r->node_bytes);
     json_g6(o, "build_cpu_s", r->build_cpu_seconds);
     json_count(o, "refits", r->refits);
     cJSON *fx = cJSON_AddObjectToObject(o, "effects");
     for (int e = 0; e < CBVH_FX_COUNT; e++)
-        if (d->effect[e].enabled) cJSON_AddItemToObject(fx, cbvh_effect_name((cbvh_effect)e), json_stats(&r->fx[e], mc));
+        if (d->effect[e].enabled)
+            cJSON_AddItemToObject(fx, cbvh_effect_name((cbvh_effect)e), json_stats(&r->fx[e], mc, incremental));
     cbvh_fx_stats t = cbvh_fx_total(r);
-    cJSON_AddItemToObject(o, "total", json_stats(&t, mc));
+    cJSON_AddItemToObject(o, "total", json_stats(&t, mc, incremental));
     json_g6(o, "area_lut4", metrics(&t, mc).area_lut4);
     cJSON *u = cJSON_AddObjectToObject(o, "units");
     uint64_t v[NUNITS];
@@ -184,6 +193,7 @@ static void print_units(const cbvh_unit_activity *u, int animated) {
 typedef struct {
     const char *scene;
     int bits, mant, min_scale, spp, json, one_sided, reps, check;
+    int box_unit, texp; /* --box-unit */
     double cache_kb;
     const char *cost_dir, *timing;
     const cbvh_format *fmt;
@@ -230,6 +240,8 @@ static int set_option(trace_opts *t, int opt, const char *v) {
         *dst[i] = (int)x;
         return 0;
     }
+    if (opt == 'u') /* --box-unit */
+        return cbvh_parse_box_unit("cbvh trace", v, &t->box_unit, &t->texp) ? 2 : 0;
     /* --format */
     char err[200];
     if (!v) v = "";
@@ -253,6 +265,7 @@ static int parse_options(int argc, char **argv, trace_opts *t) {
                                              {"min-scale", required_argument, 0, 'e'},
                                              {"spp", required_argument, 0, 's'},
                                              {"format", required_argument, 0, 'f'},
+                                             {"box-unit", required_argument, 0, 'u'},
                                              {"one-sided", no_argument, 0, 'o'},
                                              {"cache", required_argument, 0, 'c'},
                                              {"reps", required_argument, 0, 'r'},
@@ -267,7 +280,8 @@ static int parse_options(int argc, char **argv, trace_opts *t) {
                       .min_scale = CBVH_MIN_SCALE_DEFAULT,
                       .reps = 5,
                       .cache_kb = 64,
-                      .cost_dir = cbvh_cost_dir()};
+                      .cost_dir = cbvh_cost_dir(),
+                      .texp = CBVH_RBI_TEXP_DEFAULT};
     int c, rc = set_option(t, 'f', "cbvh");
     optind = 1;
     opterr = 0;
@@ -293,6 +307,11 @@ static int parse_options(int argc, char **argv, trace_opts *t) {
     }
     if (!t->scene) {
         fprintf(stderr, "cbvh trace: no scene file given (see cbvh trace --help)\n");
+        return 2;
+    }
+    if (t->box_unit == CBVH_FORMAT_BOX_INCREMENTAL && !(t->fmt->flags & CBVH_FORMAT_BOX_UNIT)) {
+        fprintf(stderr, "cbvh trace: --box-unit incremental: format %s has no incremental box unit (cbvh has)\n",
+                t->spec);
         return 2;
     }
     return 0;
@@ -363,12 +382,16 @@ static void write_json(const trace_opts *t, const cbvh_scene_desc *d, const cbvh
     cJSON_AddNumberToObject(root, "bits", t->bits);
     cJSON_AddNumberToObject(root, "mant", t->mant);
     cJSON_AddNumberToObject(root, "min_scale", t->min_scale);
+    if (t->box_unit == CBVH_FORMAT_BOX_INCREMENTAL) {
+        cJSON_AddStringToObject(root, "box_unit", "incremental");
+        cJSON_AddNumberToObject(root, "texp", t->texp);
+    }
     json_count(root, "camera_samples_without_ray", rf->samples_without_ray);
     json_count(root, "pixels_without_camera_ray", rf->pixels_without_ray);
     json_machine(root, tp, t, tm);
-    json_result(root, "float", d, rf, &tm->f.mc[0]);
+    json_result(root, "float", d, rf, &tm->f.mc[0], 0);
     if (rc) {
-        json_result(root, t->fmt->name, d, rc, &tm->m.mc[0]);
+        json_result(root, t->fmt->name, d, rc, &tm->m.mc[0], t->box_unit == CBVH_FORMAT_BOX_INCREMENTAL);
         cJSON_AddBoolToObject(root, "same_hits", same);
     }
     cbvh_json_print(root, stdout); /* a write error is main's one line */
@@ -386,7 +409,7 @@ static void write_table(const trace_opts *t, const cbvh_scene_desc *d, const cbv
            rf->frames > 1 ? " (animated: refit per frame)" : " (static)", cams[d->camera.type], d->camera.width,
            d->camera.height, spp_used);
     char desc[200];
-    cbvh_format_params fp = {{t->bits, t->min_scale}, t->mant, t->one_sided};
+    cbvh_format_params fp = {{t->bits, t->min_scale}, t->mant, t->one_sided, t->box_unit, t->texp};
     t->fmt->describe(&fp, desc, sizeof desc);
     printf("format %s: %s; %s memory %llu B", t->spec, desc, t->fmt->memory, (unsigned long long)main_r->node_bytes);
     if (rc)
@@ -431,6 +454,11 @@ static void write_table(const trace_opts *t, const cbvh_scene_desc *d, const cbv
                (unsigned long long)main_r->pixels_without_ray,
                (unsigned long long)d->camera.width * (unsigned long long)d->camera.height);
     if (tt.rejected) printf("rays rejected by a unit (no hit): %llu\n", (unsigned long long)tt.rejected);
+    if (rc && t->box_unit == CBVH_FORMAT_BOX_INCREMENTAL)
+        printf("incremental box unit (M=%d, X=%d): false-positive box hits %.2f per ray (%.1f%% of its box tests: "
+               "unit 6 at M=%d rejects them), triangle tests under them %.2f per ray (%.1f%%)\n",
+               t->mant, t->texp, pm.fp_box, 100.0 * cbvh_ratio(pm.fp_box, pm.box), t->mant, pm.fp_tri,
+               100.0 * cbvh_ratio(pm.fp_tri, pm.tri));
     print_units(&main_r->units, main_r->frames > 1);
     printf("build%s: %.3f s CPU (%s%s)\n", main_r->frames > 1 ? " + refits" : "", main_r->build_cpu_seconds,
            t->fmt->build_note, main_r->frames > 1 ? t->fmt->refit_note : "");
@@ -552,6 +580,8 @@ int cmd_trace(int argc, char **argv) {
                        .progress = tty ? progress : NULL,
                        .ctx = &pc,
                        .one_sided = t.one_sided,
+                       .box_unit = t.box_unit,
+                       .texp = t.texp,
                        .cache_kb = &t.cache_kb,
                        .ncaches = 1,
                        .cache_ways = (int)tp.cache_ways};

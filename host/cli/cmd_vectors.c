@@ -31,7 +31,8 @@ static void usage_gen(FILE *f) {
             "adds/updates their SHA-256 lines in DIR/MANIFEST. Without --unit/--bits/--min-scale it\n"
             "writes the default set: every datapath unit x N=3..10 x both encodings (where the unit\n"
             "has one), min_scale -30, plus N=6 with min_scale -126 and -10 for the axis units; the\n"
-            "units that do not depend on N (ray_box, ray_triangle, qbvh_stack, ray_sphere) get one file each (N=6).\n\n"
+            "units that do not depend on N (ray_box, ray_triangle, qbvh_stack, ray_sphere) get one file each (N=6),\n"
+            "ray_box_incr one per N=3..10 (min_scale -30).\n\n"
             "  -u, --unit U           one unit (");
     for (int i = 0; i < cbvh_unit_count; i++) fprintf(f, "%s%s", i ? ", " : "", cbvh_units[i]->name);
     fprintf(f, ")\n"

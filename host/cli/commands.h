@@ -6,7 +6,10 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "cbvh/format.h"
+#include "cbvh/ray_box_incr.h"
 #include "util/json.h" /* the --json writer and its UTF-8 rule */
 
 int cmd_vectors(int argc, char **argv); /* cmd_vectors.c: gen | check */
@@ -39,6 +42,27 @@ static inline void cbvh_print_x(double r, int prec) {
         printf(" x%.*f", prec, r);
     else
         printf(" %*s", prec + 3, isnan(r) ? "-" : "x inf");
+}
+
+/* --box-unit of trace and sweep: "exact", "incremental" or "incremental:X"
+ * (X in 3..8) into *unit (CBVH_FORMAT_BOX_*) and *texp (X, 8 unless given);
+ * 0, or -1 after a one-line message naming CMD. */
+static inline int cbvh_parse_box_unit(const char *cmd, const char *v, int *unit, int *texp) {
+    *texp = CBVH_RBI_TEXP_DEFAULT;
+    if (v && strcmp(v, "exact") == 0) {
+        *unit = CBVH_FORMAT_BOX_EXACT;
+        return 0;
+    }
+    if (v && strncmp(v, "incremental", 11) == 0 &&
+        (v[11] == 0 || (v[11] == ':' && v[12] >= '0' + CBVH_RBI_TEXP_MIN && v[12] <= '0' + CBVH_RBI_TEXP_MAX &&
+                        v[13] == 0))) {
+        *unit = CBVH_FORMAT_BOX_INCREMENTAL;
+        if (v[11] == ':') *texp = v[12] - '0';
+        return 0;
+    }
+    fprintf(stderr, "%s: --box-unit expects exact, incremental or incremental:X (X in %d..%d), got '%s'\n", cmd,
+            CBVH_RBI_TEXP_MIN, CBVH_RBI_TEXP_MAX, v ? v : "");
+    return -1;
 }
 
 #endif

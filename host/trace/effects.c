@@ -308,7 +308,7 @@ int cbvh_fx_run(const cbvh_scene_desc *d, const cbvh_fx_opts *o, cbvh_fx_result 
     const cbvh_camera *c = &d->camera;
     cbvh_format_pinhole pin = {c->width, c->height, {c->position[0], c->position[1], c->position[2]}, pinhole_dir, c};
     cbvh_format_input in = {.spec = spec,
-                            .p = {o->params, o->mant, o->one_sided},
+                            .p = {o->params, o->mant, o->one_sided, o->box_unit, o->texp},
                             .scene = &frame0,
                             .eps = T.eps,
                             .pinhole = c->type == CBVH_CAM_PINHOLE ? &pin : NULL};

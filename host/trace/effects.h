@@ -46,6 +46,7 @@ typedef struct {
     int ncaches;
     int cache_ways;
     cbvh_step_log *steps;
+    int box_unit, texp;    /* the box unit of a format that takes one (cbvh_format_params) */
 } cbvh_fx_opts;
 
 /* A run: counters per effect (cbvh_fx_stats, trace/metrics.h) and invocations

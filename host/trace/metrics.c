@@ -14,6 +14,8 @@ static void trav_stats_add(cbvh_trav_stats *sum, const cbvh_trav_stats *st) {
     if (st->max_stack > sum->max_stack) sum->max_stack = st->max_stack;
     sum->qstack_pushes += st->qstack_pushes;
     sum->qstack_pops += st->qstack_pops;
+    sum->fp_box_hits += st->fp_box_hits;
+    sum->fp_tri_tests += st->fp_tri_tests;
 }
 
 void cbvh_fx_stats_add_ray(cbvh_fx_stats *s, cbvh_trav_mode mode, int rejected, int hit, const cbvh_trav_stats *st,
@@ -99,6 +101,8 @@ int cbvh_ray_metrics_of(const cbvh_fx_stats *s, const cbvh_machine *mc, cbvh_ray
     m->tri = (double)s->st.tri_tests / n;
     m->nodes = (double)s->st.nodes / n;
     m->bytes = (double)s->st.bytes / n;
+    m->fp_box = (double)s->st.fp_box_hits / n;
+    m->fp_tri = (double)s->st.fp_tri_tests / n;
     m->dram_bytes = (double)w.miss_lines * 64.0 / n;
     m->hit_rate = w.cache_kb > 0 && w.lines ? 1.0 - (double)w.miss_lines / (double)w.lines : 0;
     if (rc == 0) {

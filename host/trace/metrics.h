@@ -61,6 +61,8 @@ typedef struct {
 typedef struct {
     uint64_t rays;
     double box, tri, nodes, bytes; /* box tests, triangle tests, inner nodes, bytes read per ray (no cache) */
+    double fp_box, fp_tri;         /* the incremental box unit's false-positive box hits and the triangle
+                                       tests under them, per ray (0 with the exact unit) */
     double model_ns;               /* the timing model's time per ray (docs/timing_model.md) */
     double energy_nj;              /* the model's energy per ray: units + cache + DRAM */
     double area_lut4;              /* the units' area (instances x LUT4) */

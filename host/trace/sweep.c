@@ -141,6 +141,8 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char
     fo.cache_kb = c->o->cache_kb;
     fo.ncaches = c->o->ncaches;
     fo.cache_ways = c->o->cache_ways;
+    fo.box_unit = c->o->box_unit; /* only a format that takes a box unit reads it: the CBVH */
+    fo.texp = c->o->texp;
     int rc = cbvh_fx_run(c->d, &fo, &run->r, err, errlen);
     for (size_t p = 0; p < npx; p++) {
         double v = floor(c->shade[p] + 0.5);
@@ -170,7 +172,9 @@ static int timed_reps(sweep_ctx *c, cbvh_sweep_result *res, char *err, size_t er
                                .spp = o->spp,
                                .progress = on_progress,
                                .ctx = c,
-                               .one_sided = o->one_sided};
+                               .one_sided = o->one_sided,
+                               .box_unit = o->box_unit,
+                               .texp = o->texp};
             cbvh_fx_result rep;
             if (cbvh_fx_run(c->d, &fo, &rep, err, errlen)) return -1;
             if (cbvh_fx_add_rep(&run->r, &rep)) {

@@ -76,6 +76,7 @@ typedef struct {
     double cache_kb[CBVH_CACHES_MAX];
     int ncaches, cache_ways;
     int reps;
+    int box_unit, texp; /* the CBVH rows' box unit (cbvh_format_params): exact, or incremental at X = texp */
     /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows +
      * k = extra format k, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
      * for a closest hit, the opposite answer for an any-hit ray); a ray the

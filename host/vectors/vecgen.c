@@ -13,10 +13,10 @@
 
 /* One entry per unit (defined in host/vectors/gen/<unit>.c). */
 extern const vg_unit vg_scale_estimate, vg_axis_compress, vg_axis_decode, vg_nodepair_encode, vg_nodepair_decode,
-    vg_ray_box, vg_ray_triangle, vg_qbvh_stack, vg_ray_sphere;
+    vg_ray_box, vg_ray_triangle, vg_qbvh_stack, vg_ray_sphere, vg_ray_box_incr;
 static const vg_unit *const unit_gens[] = {
     &vg_scale_estimate, &vg_axis_compress, &vg_axis_decode, &vg_nodepair_encode, &vg_nodepair_decode,
-    &vg_ray_box,        &vg_ray_triangle,  &vg_qbvh_stack,  &vg_ray_sphere,
+    &vg_ray_box,        &vg_ray_triangle,  &vg_qbvh_stack,  &vg_ray_sphere,     &vg_ray_box_incr,
 };
 
 static const vg_unit *find_gen(const cbvh_unit *u) {

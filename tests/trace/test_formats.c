@@ -229,7 +229,7 @@ static void hits_through_table(void) {
         if (cbvh_format_find(variants[i])) specs[ns++] = variants[i];
     for (int one_sided = 0; one_sided < 2; one_sided++) {
         memcpy(tris, s.tris, (size_t)s.ntris * sizeof *tris);
-        cbvh_format_input in = {.p = {{6, CBVH_MIN_SCALE_DEFAULT}, 24, one_sided}, .scene = &frame, .eps = eps,
+        cbvh_format_input in = {.p = {{6, CBVH_MIN_SCALE_DEFAULT}, 24, one_sided, CBVH_FORMAT_BOX_EXACT, 0}, .scene = &frame, .eps = eps,
                                 .origin_max = fmaxf(fmaxf(fabsf(cam.pos[0]), fabsf(cam.pos[1])), fabsf(cam.pos[2])),
                                 .pinhole = &pin};
         void *state[64] = {0}, *ref2 = NULL;

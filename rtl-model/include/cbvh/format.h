@@ -40,7 +40,12 @@ typedef struct {
     cbvh_params cbvh; /* N and min scale (CBVH_FORMAT_USES_N) */
     int mant;         /* M of the ray-box unit, CBVH_MANT_MIN..CBVH_MANT_MAX (CBVH_FORMAT_USES_MANT) */
     int one_sided;    /* rays are traced with CBVH_TRAV_FRONT_ONLY (back-face culling needs it) */
+    int box_unit;     /* CBVH_FORMAT_BOX_EXACT (0) or CBVH_FORMAT_BOX_INCREMENTAL (CBVH_FORMAT_BOX_UNIT) */
+    int texp;         /* X of the incremental unit's distances, 3..8; 0 = 8 (CBVH_FORMAT_BOX_UNIT) */
 } cbvh_format_params;
+
+#define CBVH_FORMAT_BOX_EXACT 0       /* unit 6: every plane distance exact, rounded once (docs/traversal.md §3) */
+#define CBVH_FORMAT_BOX_INCREMENTAL 1 /* unit 10: Eq. 5, the parent's distances on the stack (§17) */
 
 /* A pinhole camera's primary rays: origin `position`, direction dir(ctx, u,
  * v) through the image point (u, v) in [0, 1]^2 (u across, v down). */
@@ -74,6 +79,7 @@ typedef struct {
 #define CBVH_FORMAT_OPTIONS 4u      /* spelled name[:option...] */
 #define CBVH_FORMAT_REFERENCE 8u    /* the float BVH, whose hits every format must return */
 #define CBVH_FORMAT_STACK_UNIT 16u  /* its traversal runs the QBVH stack unit (unit 8) */
+#define CBVH_FORMAT_BOX_UNIT 32u    /* takes the box unit (box_unit, texp): exact or incremental */
 
 #define CBVH_FORMAT_NAME_MAX 48 /* a canonical spec with its terminating NUL */
 

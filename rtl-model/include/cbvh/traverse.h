@@ -27,6 +27,9 @@ typedef struct cbvh_trav_stats {
     /* QBVH stack unit (unit 8) operations; 0 for the binary traversals. */
     uint64_t qstack_pushes; /* sort + push operations: one per inner node visited */
     uint64_t qstack_pops;   /* pop operations */
+    /* The incremental ray-box unit (unit 10, cbvh_trace_cbvh_incr); 0 for the others. */
+    uint64_t fp_box_hits;   /* children it hits that the exact unit (unit 6, same M) misses */
+    uint64_t fp_tri_tests;  /* triangle tests in leaves reached through such a child */
 } cbvh_trav_stats;
 
 /* An observer of the traversals' memory reads, for a cache and timing model

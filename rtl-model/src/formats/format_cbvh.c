@@ -10,6 +10,7 @@
 #include "cbvh/cbvh_tree.h"
 #include "cbvh/format.h"
 #include "cbvh/oom.h"
+#include "cbvh/traverse_incr.h"
 
 typedef struct {
     cbvh_bvh bvh; /* the float BVH the CBVH is compressed from (refitted by the streaming refit) */
@@ -17,10 +18,15 @@ typedef struct {
     int have_tree;
     cbvh_params params;
     int mant;
+    int incremental, texp; /* the box unit: unit 10 at X = texp, else unit 6 */
 } state;
 
 static void describe(const cbvh_format_params *p, char *out, size_t n) {
-    snprintf(out, n, "N=%d, M=%d, min scale %d, modulo", p->cbvh.quant_bits, p->mant, p->cbvh.min_scale);
+    if (p->box_unit == CBVH_FORMAT_BOX_INCREMENTAL)
+        snprintf(out, n, "N=%d, M=%d, min scale %d, modulo, incremental box unit (X=%d)", p->cbvh.quant_bits, p->mant,
+                 p->cbvh.min_scale, p->texp ? p->texp : CBVH_RBI_TEXP_DEFAULT);
+    else
+        snprintf(out, n, "N=%d, M=%d, min scale %d, modulo", p->cbvh.quant_bits, p->mant, p->cbvh.min_scale);
 }
 
 /* Compresses s->bvh (refitting it to refit_tris first unless NULL) into a
@@ -56,6 +62,8 @@ static int build(const cbvh_format_input *in, void **st, cbvh_unit_activity *u, 
     if (!s) cbvh_out_of_memory("format state");
     s->params = in->p.cbvh;
     s->mant = in->p.mant;
+    s->incremental = in->p.box_unit == CBVH_FORMAT_BOX_INCREMENTAL;
+    s->texp = in->p.texp ? in->p.texp : CBVH_RBI_TEXP_DEFAULT;
     if (cbvh_build_sah(in->scene, 0, 0, &s->bvh, err, errlen) || compress(s, NULL, u, err, errlen)) {
         release(s);
         return -1;
@@ -75,6 +83,7 @@ static int trace(const void *st, const cbvh_tri *tris, const cbvh_ray *ray, cbvh
                  const cbvh_format_from *from, cbvh_trav_hit *hit, cbvh_trav_stats *ts) {
     (void)from;
     const state *s = st;
+    if (s->incremental) return cbvh_trace_cbvh_incr(&s->tree, tris, ray, s->mant, s->texp, mode, hit, ts);
     return cbvh_trace_cbvh(&s->tree, tris, ray, s->mant, mode, hit, ts);
 }
 
@@ -90,5 +99,5 @@ static void units(const cbvh_trav_stats *sum, cbvh_unit_activity *u) {
 const cbvh_format cbvh_format_cbvh = {
     .name = "cbvh", .title = "CBVH", .help = "cbvh: the CBVH against the float BVH (default)", .memory = "node",
     .build_note = "CBVH: SAH build + bottom-up streaming compression", .refit_note = "",
-    .flags = CBVH_FORMAT_USES_N | CBVH_FORMAT_USES_MANT,
+    .flags = CBVH_FORMAT_USES_N | CBVH_FORMAT_USES_MANT | CBVH_FORMAT_BOX_UNIT,
     .describe = describe, .build = build, .refit = refit, .trace = trace, .bytes = bytes, .units = units, .free = release};

@@ -60,11 +60,8 @@ int cbvh_trace_cbvh(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ray *ra
             if (trav_cbvh_leaf(&ts, t, e->ptr, &cull, &cull_d)) break;
             continue;
         }
-        /* a tree visits each pair at most once per ray: more is a pointer cycle */
-        if (e->ptr >= t->npairs || ts.s.nodes >= t->npairs) return -1;
-        ts.s.nodes++;
-        trav_fetch(&ts, CBVH_FETCH_NODE, (uint64_t)e->ptr * t->pair_bytes, t->pair_bytes);
-        const uint8_t *pair = t->pairs + (size_t)e->ptr * t->pair_bytes;
+        const uint8_t *pair = trav_cbvh_pair(&ts, t, e->ptr);
+        if (!pair) return -1;
         cbvh_node_ctx ctx = e->ctx; /* e's slot is reused by the pushes below */
         double tn[2];
         int h[2] = {0, 0};

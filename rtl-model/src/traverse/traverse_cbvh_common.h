@@ -1,5 +1,5 @@
-/* Pieces the two CBVH traversals share (docs/traversal.md §5, §9, §12):
- * the root box test and a leaf's triangles.  Internal to rtl-model. */
+/* Pieces the CBVH traversals share (docs/traversal.md §5, §9, §12):
+ * the root box test, an inner node's visit and a leaf's triangles.  Internal to rtl-model. */
 #ifndef CBVH_TRAVERSE_CBVH_COMMON_H
 #define CBVH_TRAVERSE_CBVH_COMMON_H
 
@@ -23,6 +23,16 @@ static inline int trav_cbvh_root(trav_state *ts, const cbvh_rbf_ray *fp, const c
         *t_near = cbvh_rbf_f32(r.t_near);
     }
     return hit;
+}
+
+/* An inner node's pair at index ptr: counts the visit and its fetch.  NULL
+ * when ptr is out of range or the visits outnumber the pairs (a tree visits
+ * each pair at most once per ray: more is a pointer cycle). */
+static inline const uint8_t *trav_cbvh_pair(trav_state *ts, const cbvh_tree *t, uint32_t ptr) {
+    if (ptr >= t->npairs || ts->s.nodes >= t->npairs) return NULL;
+    ts->s.nodes++;
+    trav_fetch(ts, CBVH_FETCH_NODE, (uint64_t)ptr * t->pair_bytes, t->pair_bytes);
+    return t->pairs + (size_t)ptr * t->pair_bytes;
 }
 
 /* A leaf's triangles from ID index `first` to the one marked last (their

@@ -6,6 +6,7 @@
 
 #include "cbvh/traversal_units.h"
 #include "cbvh/qbvh_stack.h"
+#include "cbvh/ray_box_incr.h"
 
 static void add(cbvh_field *f, int *n, const char *name, int digits) {
     f[*n].name = name;
@@ -305,6 +306,56 @@ static void ray_sphere_eval(const cbvh_unit_config *cfg, const uint32_t *in, uin
     out[1] = st;
 }
 
+/* ---- ray_box_incr (docs/traversal.md §17): one child of a node ---- */
+static const char *const incr_in_names[3][5] = {{"x_t_lb", "x_t_ub", "x_scale", "x_r", "x_sp"},
+                                                {"y_t_lb", "y_t_ub", "y_scale", "y_r", "y_sp"},
+                                                {"z_t_lb", "z_t_ub", "z_scale", "z_r", "z_sp"}};
+static const char *const incr_out_names[6] = {"x_c_lb", "x_c_ub", "y_c_lb", "y_c_ub", "z_c_lb", "z_c_ub"};
+static void ray_box_incr_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
+    (void)cfg;
+    l->n_in = l->n_out = 0;
+    add(l->in, &l->n_in, "rcp_x", F32);
+    add(l->in, &l->n_in, "rcp_y", F32);
+    add(l->in, &l->n_in, "rcp_z", F32);
+    add(l->in, &l->n_in, "tmin", F32);
+    add(l->in, &l->n_in, "tmax", F32);
+    add(l->in, &l->n_in, "mant", 2);
+    add(l->in, &l->n_in, "texp", 2);
+    for (int a = 0; a < 3; a++) {
+        static const int digits[5] = {F32, F32, SCALE, CODE, CODE};
+        for (int i = 0; i < 5; i++) add(l->in, &l->n_in, incr_in_names[a][i], digits[i]);
+    }
+    add(l->out, &l->n_out, "hit", 1);
+    add(l->out, &l->n_out, "t_near", F32);
+    add(l->out, &l->n_out, "t_far", F32);
+    for (int i = 0; i < 6; i++) add(l->out, &l->n_out, incr_out_names[i], F32);
+    add(l->out, &l->n_out, "status", STATUS);
+}
+static void ray_box_incr_eval(const cbvh_unit_config *cfg, const uint32_t *in, uint32_t *out) {
+    cbvh_rbi_params p = {cfg->params.quant_bits, (int)in[5], (int)in[6]};
+    cbvh_rbi_ray ray = {{in[0], in[1], in[2]}, in[3], in[4]};
+    cbvh_rbi_planes par;
+    cbvh_rbi_axis ch[3];
+    for (int a = 0; a < 3; a++) {
+        const uint32_t *w = in + 7 + 5 * a;
+        par.t_lb[a] = w[0];
+        par.t_ub[a] = w[1];
+        ch[a].e = cbvh_scale_from_word(w[2]);
+        ch[a].r = w[3];
+        ch[a].sp = w[4];
+    }
+    cbvh_rbi_result res;
+    uint32_t st = cbvh_ray_box_incr(&p, &ray, &par, ch, &res);
+    out[0] = (uint32_t)res.hit;
+    out[1] = res.t_near;
+    out[2] = res.t_far;
+    for (int a = 0; a < 3; a++) {
+        out[3 + 2 * a] = res.planes.t_lb[a];
+        out[4 + 2 * a] = res.planes.t_ub[a];
+    }
+    out[9] = st;
+}
+
 /* ---- qbvh_stack (docs/qbvh.md §2) ---- */
 static void qstack_layout(const cbvh_unit_config *cfg, cbvh_layout *l) {
     (void)cfg;
@@ -362,10 +413,11 @@ static const cbvh_unit unit_ray_box = {"ray_box", 6, 0, ray_box_layout, ray_box_
 static const cbvh_unit unit_ray_triangle = {"ray_triangle", 7, 0, ray_tri_layout, ray_tri_eval};
 static const cbvh_unit unit_qbvh_stack = {"qbvh_stack", 8, 0, qstack_layout, qstack_eval};
 static const cbvh_unit unit_ray_sphere = {"ray_sphere", 9, 0, ray_sphere_layout, ray_sphere_eval};
+static const cbvh_unit unit_ray_box_incr = {"ray_box_incr", 10, 0, ray_box_incr_layout, ray_box_incr_eval};
 
 const cbvh_unit *const cbvh_units[] = {&unit_estimate, &unit_compress, &unit_decode, &unit_encode_pair,
                                        &unit_decode_pair, &unit_ray_box, &unit_ray_triangle,
-                                       &unit_qbvh_stack, &unit_ray_sphere};
+                                       &unit_qbvh_stack, &unit_ray_sphere, &unit_ray_box_incr};
 const int cbvh_unit_count = (int)(sizeof cbvh_units / sizeof cbvh_units[0]);
 
 const cbvh_unit *cbvh_unit_find(const char *name) {

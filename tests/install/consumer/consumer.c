@@ -90,13 +90,13 @@ static void check_word(const vecfile *v, const char *what, uint32_t got, uint32_
 static long check_compress(const char *dir) {
     vecfile v;
     vec_open(&v, dir, "axis_compress-N6-ms-30.vec");
-    expect_fields(&v, "lb ub scale -> lb_mod ub_mod child_scale clb cub status");
-    uint32_t in[3], out[6];
+    expect_fields(&v, "lb ub scale node_clb -> lb_mod ub_mod child_scale clb cub status");
+    uint32_t in[4], out[6];
     long n = 0;
-    for (; vec_next(&v, 3, in, 6, out); n++) {
+    for (; vec_next(&v, 4, in, 6, out); n++) {
         cbvh_axis_code c;
         memset(&c, 0, sizeof c);
-        uint32_t st = cbvh_axis_compress(&v.cfg.params, in[0], in[1], cbvh_scale_from_word(in[2]), &c);
+        uint32_t st = cbvh_axis_compress(&v.cfg.params, in[0], in[1], cbvh_scale_from_word(in[2]), in[3], &c);
         check_word(&v, "lb_mod", c.lb_mod, out[0]);
         check_word(&v, "ub_mod", c.ub_mod, out[1]);
         check_word(&v, "child_scale", cbvh_scale_to_word(c.child_scale), out[2]);
@@ -210,7 +210,7 @@ static long check_roundtrip(void) {
                 float a = lo + (float)uniform() * (hi - lo), b = lo + (float)uniform() * (hi - lo);
                 float clo = a < b ? a : b, chi = a < b ? b : a;
                 cbvh_axis_code code;
-                st = cbvh_axis_compress(&p, cbvh_f32_of(clo), cbvh_f32_of(chi), ctx.scale, &code);
+                st = cbvh_axis_compress(&p, cbvh_f32_of(clo), cbvh_f32_of(chi), ctx.scale, ctx.clb, &code);
                 if (st) fail("compress [%g, %g] in [%g, %g] N=%d: status %u", clo, chi, lo, hi, quant_bits, st);
                 if (!f32_le(code.clb, cbvh_f32_of(clo)) || !f32_le(cbvh_f32_of(chi), code.cub))
                     fail("compress [%g, %g] N=%d: decoded [%g, %g] does not enclose it", clo, chi, quant_bits,
