@@ -298,8 +298,10 @@ static cJSON *json_costs(const cbvh_fx_stats *s, const cbvh_fx_stats *f, uint64_
         json_rel(mo, "cache_kb", ms->mc[c].cache_kb); /* null: infinite */
         cJSON_AddNumberToObject(mo, "ns_per_ray", a.model_ns);
         cbvh_model_json(mo, &a);
-        cJSON_AddNumberToObject(mo, "false_positive_box_hits_per_ray", 0); /* the exact unit: none (issue 35) */
-        cJSON_AddNumberToObject(mo, "extra_tri_tests_per_ray", 0);
+        /* the incremental unit's accepted boxes that unit 6 rejects, and the
+         * triangle tests under them (0 for the exact unit and other formats) */
+        cJSON_AddNumberToObject(mo, "false_positive_box_hits_per_ray", a.fp_box);
+        cJSON_AddNumberToObject(mo, "extra_tri_tests_per_ray", a.fp_tri);
         cJSON *mr = cJSON_AddObjectToObject(mo, "relative_to_float");
         json_rel(mr, "time", cbvh_ratio(a.model_ns, b.model_ns));
         json_rel(mr, "energy", cbvh_ratio(a.energy_nj, b.energy_nj));
@@ -974,7 +976,7 @@ static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, con
                              o->min_scale[e], tag);
                 snprintf(title, sizeof title, "%s: modelled %s per ray, cache %s, min scale %d, %s box unit", mesh,
                          q ? "energy" : "time", cbvh_cache_name(o->cache_kb[ci], cn, sizeof cn), o->min_scale[e],
-                         cbvh_box_units[0].name);
+                         cbvh_box_units[o->box_unit].name);
                 int bad = cbvh_svg_chart(path, title, "coordinate bits N", q ? "nJ per ray" : "ns per ray", x,
                                          (size_t)f->nb, ser, (size_t)nm + 1, err, sizeof err);
                 file_done(w, path, bad, err);
@@ -1248,10 +1250,10 @@ static void write_model_text(const sweep_cli *c, const cbvh_scene_desc *d, const
     char line[400], name[64], cn[32];
     cbvh_machine_line(&f->tp, line, sizeof line);
     printf("\nWhat accuracy costs in time (timing model, docs/timing_model.md): %s\n", line);
-    printf("%-28s %-6s %7s %9s %8s %10s %9s %6s %6s %6s %-13s %-20s | %7s %7s %7s  %s\n", "setting", "box", "cache",
+    printf("%-28s %-11s %7s %9s %8s %10s %9s %6s %6s %6s %-13s %-20s | %7s %7s %7s  %s\n", "setting", "box", "cache",
            "ns/ray", "nJ/ray", "area LUT4", "DRAM B/r", "hit %", "fp box", "fp tri", "bound", "CPU us/ray [min-max]",
            "time", "energy", "area", "P");
-    printf("%-28s %-6s %7s %9s %8s %10s %9s %6s %6s %6s %-13s %-20s | %25s\n", "", "unit", "", "", "", "", "", "", "",
+    printf("%-28s %-11s %7s %9s %8s %10s %9s %6s %6s %6s %-13s %-20s | %25s\n", "", "unit", "", "", "", "", "", "", "",
            "", "", "", "x the float BVH (same cache)");
     for (int k = 0; k < f->ncfg; k++) {
         const cbvh_sweep_run_t *r = cfg_run(res, k);
@@ -1260,12 +1262,14 @@ static void write_model_text(const sweep_cli *c, const cbvh_scene_desc *d, const
         int sphere = t.ops.ray_sphere > 0;
         for (int ci = 0; ci < f->ncaches; ci++) {
             const cbvh_ray_metrics *m = &f->tot[(size_t)k * f->ncaches + ci], *fl = &f->tot[ci];
-            char cpu[40];
+            char cpu[40], fpb[16], fpt[16];
             snprintf(cpu, sizeof cpu, "%.2f [%.2f-%.2f]", m->cpu_us, m->cpu_lo, m->cpu_hi);
-            printf("%-28s %-6s %7s %9.1f %8.3f %10.0f %9.1f %6.1f %6s %6s %-13s %-20s |", name,
+            snprintf(fpb, sizeof fpb, "%.2f", m->fp_box);
+            snprintf(fpt, sizeof fpt, "%.2f", m->fp_tri);
+            printf("%-28s %-11s %7s %9.1f %8.3f %10.0f %9.1f %6.1f %6s %6s %-13s %-20s |", name,
                    sphere ? "sphere" : cbvh_box_units[r->s.box_unit].name,
                    cbvh_cache_name(c->run.cache_kb[ci], cn, sizeof cn), m->model_ns, m->energy_nj, m->area_lut4,
-                   m->dram_bytes, 100.0 * m->hit_rate, sphere ? "-" : "0", sphere ? "-" : "0",
+                   m->dram_bytes, 100.0 * m->hit_rate, sphere ? "-" : fpb, sphere ? "-" : fpt,
                    cbvh_timing_bound_name(m->bound), cpu);
             print_rel(cbvh_ratio(m->model_ns, fl->model_ns));
             print_rel(cbvh_ratio(m->energy_nj, fl->energy_nj));
@@ -1274,8 +1278,8 @@ static void write_model_text(const sweep_cli *c, const cbvh_scene_desc *d, const
         }
     }
     printf("P * = on the Pareto front of (time, energy, area) over every row and cache size. fp box / fp tri: false-"
-           "positive box hits and the extra triangle tests they cause, per ray: none for the exact unit (issue 35's "
-           "incremental unit adds them).\n");
+           "positive box hits and the extra triangle tests they cause, per ray (those the incremental unit accepts and "
+           "unit 6 at the same M rejects; none for the exact unit).\n");
     printf("fastest in modelled time (CPU time is the C model's own, not the accelerator's):\n");
     for (int ci = 0; ci < f->ncaches; ci++) {
         cbvh_cache_name(c->run.cache_kb[ci], cn, sizeof cn);

@@ -496,7 +496,7 @@ static int timing_check(const trace_opts *t, const cbvh_scene_desc *d, const cbv
         cbvh_fx_result r;
         cbvh_timing_units u;
         if (cbvh_fx_run(d, &fo, &r, err, sizeof err) ||
-            cbvh_fx_units(&r, table, tp, "ray_box", t->bits, t->mant, &u, err, sizeof err)) {
+            cbvh_fx_units(&r, table, tp, cbvh_box_units[t->box_unit].cost_unit, t->bits, t->mant, &u, err, sizeof err)) {
             fprintf(stderr, "cbvh trace: %s: %s\n", t->scene, err);
             cbvh_step_log_free(&log);
             cJSON_Delete(arr);
@@ -509,7 +509,8 @@ static int timing_check(const trace_opts *t, const cbvh_scene_desc *d, const cbv
                 cbvh_timing_units uu = u;
                 if (uv) { /* v1's units: one cycle, pipelined */
                     p.box_cycles = p.tri_cycles = 1;
-                    cbvh_fx_units(&r, table, &p, "ray_box", t->bits, t->mant, &uu, err, sizeof err);
+                    cbvh_fx_units(&r, table, &p, cbvh_box_units[t->box_unit].cost_unit, t->bits, t->mant, &uu, err,
+                                  sizeof err);
                 }
                 cbvh_event_result ev;
                 /* at least 50 rays per slot, so start-up and drain stay small */
@@ -602,7 +603,8 @@ int cmd_trace(int argc, char **argv) {
         same = rc.hit_digest == rf.hit_digest; /* every format must return the float BVH's hits */
     }
     if (!status && (cbvh_config_model_init(&tm.f, &rf, &table, &tp, "ray_box", 6, 24, err, sizeof err) ||
-                    cbvh_config_model_init(&tm.m, cmp ? &rc : &rf, &table, &tp, "ray_box", t.bits, t.mant, err,
+                    cbvh_config_model_init(&tm.m, cmp ? &rc : &rf, &table, &tp,
+                                           cbvh_box_units[cmp ? t.box_unit : 0].cost_unit, t.bits, t.mant, err,
                                            sizeof err))) {
         fprintf(stderr, "cbvh trace: %s\n", err);
         status = 2;

@@ -398,6 +398,8 @@ int cbvh_fx_add_rep(cbvh_fx_result *main, const cbvh_fx_result *rep) {
     return 0;
 }
 
+const cbvh_box_unit cbvh_box_units[CBVH_BOX_UNITS] = {{"exact", "ray_box"}, {"incremental", "ray_box_incr"}};
+
 int cbvh_fx_units(const cbvh_fx_result *r, const cbvh_cost_table *t, const cbvh_timing_params *tp,
                   const char *box_unit, int n, int m, cbvh_timing_units *u, char *err, size_t errlen) {
     cbvh_fx_stats s = cbvh_fx_total(r);

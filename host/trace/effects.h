@@ -89,6 +89,17 @@ void cbvh_fx_timing(const cbvh_scene_desc *d, cbvh_timing_params *tp);
  * hits (else -1, nothing appended). */
 int cbvh_fx_add_rep(cbvh_fx_result *main, const cbvh_fx_result *rep);
 
+/* The box units a CBVH is traced and timed with, indexed by
+ * cbvh_format_params.box_unit (CBVH_FORMAT_BOX_EXACT, _INCREMENTAL): the
+ * name in tables and the unit of the RTL cost table (trace/cost_table.h) the
+ * timing model charges for each box test: the exact unit 6 ("ray_box") or
+ * the incremental unit 10 of seed 003's Eq. 5 ("ray_box_incr"). */
+typedef struct {
+    const char *name, *cost_unit;
+} cbvh_box_unit;
+#define CBVH_BOX_UNITS 2
+extern const cbvh_box_unit cbvh_box_units[CBVH_BOX_UNITS];
+
 /* The units of a run's format (trace/timing_model.h): the node unit is the
  * sphere unit for the traversal lists, else box_unit ("ray_box" or
  * "ray_box_incr"); the decoder for a format with N (the CBVH), the stack

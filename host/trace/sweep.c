@@ -9,7 +9,6 @@
 
 #include "cbvh/oom.h"
 
-const cbvh_box_unit cbvh_box_units[CBVH_BOX_UNITS] = {{"exact", "ray_box"}};
 
 /* What the float reference returned for one ray. */
 typedef struct {
@@ -141,7 +140,7 @@ static int run_one(sweep_ctx *c, cbvh_sweep_run_t *run, const char *format, char
     fo.cache_kb = c->o->cache_kb;
     fo.ncaches = c->o->ncaches;
     fo.cache_ways = c->o->cache_ways;
-    fo.box_unit = c->o->box_unit; /* only a format that takes a box unit reads it: the CBVH */
+    fo.box_unit = run->s.box_unit; /* only a format that takes a box unit reads it: the CBVH */
     fo.texp = c->o->texp;
     int rc = cbvh_fx_run(c->d, &fo, &run->r, err, errlen);
     for (size_t p = 0; p < npx; p++) {
@@ -173,7 +172,7 @@ static int timed_reps(sweep_ctx *c, cbvh_sweep_result *res, char *err, size_t er
                                .progress = on_progress,
                                .ctx = c,
                                .one_sided = o->one_sided,
-                               .box_unit = o->box_unit,
+                               .box_unit = run->s.box_unit,
                                .texp = o->texp};
             cbvh_fx_result rep;
             if (cbvh_fx_run(c->d, &fo, &rep, err, errlen)) return -1;
@@ -245,7 +244,7 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
     for (int m = 0; m < o->nmant; m++)
         for (int e = 0; e < o->nmin_scale; e++)
             for (int b = o->bits_lo; b <= o->bits_hi; b++)
-                res->rows[k++].s = (cbvh_sweep_setting){b, o->mant[m], o->min_scale[e], 0};
+                res->rows[k++].s = (cbvh_sweep_setting){b, o->mant[m], o->min_scale[e], o->box_unit};
 
     cbvh_tri *tris0 = xcalloc(d->mesh.ntris, sizeof *tris0);
     cbvh_scene_desc_frame(d, 0, tris0);

@@ -44,22 +44,11 @@ void cbvh_sweep_format_label(const cbvh_sweep_format *f, int mant, char *out, si
  * (one, without options: its title), " and the other formats". */
 const char *cbvh_sweep_others(const cbvh_sweep_format *extra, int nextra, char *buf, size_t n);
 
-/* The box units a sweep models, by index: the name in tables and the unit
- * of the RTL cost table (trace/cost_table.h).  The exact unit (unit 6) is
- * the one the traversals run today; the incremental unit of seed 003's
- * Eq. 5 (issue 35, cost-table unit "ray_box_incr") becomes one more entry
- * when its traversal lands. */
-typedef struct {
-    const char *name, *cost_unit;
-} cbvh_box_unit;
-#define CBVH_BOX_UNITS 1
-extern const cbvh_box_unit cbvh_box_units[CBVH_BOX_UNITS];
-
 typedef struct {
     int bits; /* N; 0 = the float BVH */
     int mant; /* M of the ray-box unit */
     int min_scale;
-    int box_unit; /* index into cbvh_box_units */
+    int box_unit; /* index into cbvh_box_units: the CBVH rows' (--box-unit), 0 for other formats */
 } cbvh_sweep_setting;
 
 typedef struct {
