@@ -74,12 +74,13 @@ static uint32_t compress_general(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub,
 
 /* Fast path for the common case: valid parameters and scale, lb <= ub, both
  * bounds normal numbers whose grid step 2^e lies inside their significand
- * (cbvh_fast_in_sig: d = e - lsb exponent in [1, 23]), and node_clb a value
- * whose grid coordinate K = floor(node_clb / 2^e) is kept (cbvh_fast_floor:
- * not "huge"; -Inf is -2^128).  The grid coordinates are unit_fast.h's
- * cbvh_fast_floor_in_sig and cbvh_fast_floor and the codes and Eq. 2 child
+ * (cbvh_fast_in_sig: d = e - lsb exponent in [1, 23]), and node_clb either
+ * such a number too or +-0 (K = 0); any other node_clb (NaN, +-Inf, one below
+ * 2^e or with its lsb at or above 2^e) goes to the general path, which also
+ * decides the faults.  The grid coordinates are unit_fast.h's
+ * cbvh_fast_floor_in_sig and the codes and Eq. 2 child
  * scale its cbvh_fast_code: the same inline steps the streaming compressor
- * runs, so each has one definition.  Then 0 < |k|, |ku| < 2^24, |K| < 2^62,
+ * runs, so each has one definition.  Then 0 < |k|, |ku| < 2^24, |K| < 2^24,
  * and:
  *   - clb = RD(k 2^e) is k 2^e itself, formed on lb's bit pattern
  *     (cbvh_fast_grid_below_in_sig; -2^128 comes out as -Inf);
@@ -107,14 +108,18 @@ static inline cbvh_f32 pack_exact(int32_t v, int e) {
 uint32_t cbvh_axis_compress(const cbvh_params *p, cbvh_f32 lb, cbvh_f32 ub, int e, cbvh_f32 node_clb,
                             cbvh_axis_code *out) {
     int n = p->quant_bits, ms = p->min_scale;
-    uint32_t dl, du;
-    int64_t kn;
+    uint32_t dl, du, dn;
     if ((uint32_t)(n - CBVH_N_MIN) > (uint32_t)(CBVH_N_MAX - CBVH_N_MIN) || ms < CBVH_SCALE_FLOOR || e < ms ||
         e > CBVH_SCALE_CEIL || !(cbvh_fast_in_sig(lb, e, &dl) & cbvh_fast_in_sig(ub, e, &du)) ||
-        cbvh_fast_order_key(lb) > cbvh_fast_order_key(ub) || cbvh_grid_clb_bad(node_clb) ||
-        !cbvh_fast_floor(node_clb, e, &kn))
+        cbvh_fast_order_key(lb) > cbvh_fast_order_key(ub))
         return compress_general(p, lb, ub, e, node_clb, out);
+    /* +-0: d = 31 gives floor(v / 2^31) = 0 for either sign (|v| < 2^24) */
+    if (!cbvh_fast_in_sig(node_clb, e, &dn)) {
+        if (!cbvh_f32_is_zero(node_clb)) return compress_general(p, lb, ub, e, node_clb, out);
+        dn = 31;
+    }
     int64_t k = cbvh_fast_floor_in_sig(lb, dl), ku = cbvh_fast_floor_in_sig(ub, du);
+    int64_t kn = cbvh_fast_floor_in_sig(node_clb, dn);
     int fit = cbvh_fast_code(n, ms, e, k, ku, &out->lb_mod, &out->ub_mod, &out->child_scale);
     if (!fit) out->child_scale = e;
     out->clb = cbvh_fast_grid_below_in_sig(lb, dl);
