@@ -13,7 +13,7 @@
 #include "cbvh/unit_table.h"
 #include "vectors/vecfile.h"
 
-#define CBVH_VECGEN_VERSION 9
+#define CBVH_VECGEN_VERSION 10
 #define CBVH_VECGEN_DEFAULT_SEED UINT64_C(0xCB7C0DE5EED00001)
 #define CBVH_VECGEN_LEVEL2_RANDOM 100000 /* random vectors added by level 2 */
 #define CBVH_VECGEN_LEVEL2_EXACT 20000   /* then exact-path cases (ray units) */

@@ -190,6 +190,25 @@ static void structured(gen_t *g, int M, int X) {
         cbvh_rbi_axis ainf[3] = {{3, 2, 5}, {-3, 1, 1}, {0, 2, 0}};
         emit_incr(g, M, X, &rinf, &pinf, ainf);
     }
+    /* one parallel axis a (rcp +0 or -0) at a time, the other two crossing a box [1, 2]: the child's
+     * offsets on a wholly below, wholly above, inside and on either face of the origin, so each
+     * axis's own offsets decide the hit (generator 10: the RTL's axis-1 test reading axis 2's
+     * upper offset passed every earlier vector) */
+    for (int a = 0; a < 3; a++)
+        for (int k = 0; k < 5; k++) {
+            static const cbvh_f32 off[5][2] = {{0xC0000000u, 0xBF800000u},
+                                               {0x3F800000u, 0x40000000u},
+                                               {0xBF800000u, 0x3F800000u},
+                                               {0xBF800000u, 0},
+                                               {0, 0x3F800000u}};
+            cbvh_rbi_ray ray = {{F_ONE, F_ONE, F_ONE}, 0, CBVH_F32_POS_INF};
+            ray.rcp[a] = (k & 1) ? CBVH_F32_SIGN : 0u;
+            cbvh_rbi_planes par = {{F_ONE, F_ONE, F_ONE}, {0x40000000u, 0x40000000u, 0x40000000u}};
+            par.t_lb[a] = off[k][0];
+            par.t_ub[a] = off[k][1];
+            cbvh_rbi_axis ax[3] = {{0, 0, 0}, {-1, 0, 0}, {-2, 0, 0}};
+            emit_incr(g, M, X, &ray, &par, ax);
+        }
     /* exact cancellation: t_lb = -c 2^e rho, so the child's lower distance is exactly 0 (+0) */
     for (uint32_t c = 1; c < 4; c++) {
         cbvh_rbi_ray ray = {{F_ONE, F_HALF, 0x40000000u}, 0, CBVH_F32_POS_INF};
