@@ -87,6 +87,16 @@ static void check_word(const vecfile *v, const char *what, uint32_t got, uint32_
     if (got != want) fail("%s line %ld: %s = %08X, the vector says %08X", v->unit, v->line, what, got, want);
 }
 
+/* The six outputs both axis units share: the code and the status. */
+static void check_code(const vecfile *v, const cbvh_axis_code *c, uint32_t st, const uint32_t out[6]) {
+    check_word(v, "lb_mod", c->lb_mod, out[0]);
+    check_word(v, "ub_mod", c->ub_mod, out[1]);
+    check_word(v, "child_scale", cbvh_scale_to_word(c->child_scale), out[2]);
+    check_word(v, "clb", c->clb, out[3]);
+    check_word(v, "cub", c->cub, out[4]);
+    check_word(v, "status", st, out[5]);
+}
+
 static long check_compress(const char *dir) {
     vecfile v;
     vec_open(&v, dir, "axis_compress-N6-ms-30.vec");
@@ -97,12 +107,7 @@ static long check_compress(const char *dir) {
         cbvh_axis_code c;
         memset(&c, 0, sizeof c);
         uint32_t st = cbvh_axis_compress(&v.cfg.params, in[0], in[1], cbvh_scale_from_word(in[2]), in[3], &c);
-        check_word(&v, "lb_mod", c.lb_mod, out[0]);
-        check_word(&v, "ub_mod", c.ub_mod, out[1]);
-        check_word(&v, "child_scale", cbvh_scale_to_word(c.child_scale), out[2]);
-        check_word(&v, "clb", c.clb, out[3]);
-        check_word(&v, "cub", c.cub, out[4]);
-        check_word(&v, "status", st, out[5]);
+        check_code(&v, &c, st, out);
     }
     fclose(v.f);
     return n;
@@ -119,12 +124,7 @@ static long check_decode(const char *dir, const char *file) {
         cbvh_axis_code c;
         memset(&c, 0, sizeof c);
         uint32_t st = cbvh_axis_decode(&v.cfg.params, v.cfg.enc, &ctx, in[4], in[5], &c);
-        check_word(&v, "lb_mod", c.lb_mod, out[0]);
-        check_word(&v, "ub_mod", c.ub_mod, out[1]);
-        check_word(&v, "child_scale", cbvh_scale_to_word(c.child_scale), out[2]);
-        check_word(&v, "clb", c.clb, out[3]);
-        check_word(&v, "cub", c.cub, out[4]);
-        check_word(&v, "status", st, out[5]);
+        check_code(&v, &c, st, out);
     }
     fclose(v.f);
     return n;
