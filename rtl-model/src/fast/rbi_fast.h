@@ -68,15 +68,20 @@ typedef struct {
     uint64_t emin_b, emax_b; /* biased binary64 exponents of 2^emin and 2^emax */
     uint64_t min_bits, max_bits; /* 2^emin and the largest value of F, as binary64 bits */
     double lo, hi;         /* 2^emin and 2^(emax + 1) */
-    _Alignas(16) uint64_t up2[3][2]; /* per axis, lanes (lower, upper): all ones where the plane rounds up */
+    /* the SSE2 step's operands, in both lanes: all bits but the low 53 - M, one unit,
+     * 2^emin, the largest value of F; per axis, lanes (lower, upper): -0
+     * where the plane rounds up, else +0 */
+    _Alignas(16) double keep2[2], unit2[2], lo2[2], max2[2], upsign[3][2];
 } cbvh_rbi_fray;
 
 /* A node as its children's tests read it: its plane distances as binary64
- * (exact), lanes (lower, upper) per axis, and 2^e rho per axis for its child
- * grid e (exact: a binary32 significand times a power of two in range). */
+ * (exact), lanes (lower, upper) per axis, and per axis 2^e rho for its child
+ * grid e and its negation, (2^e rho, -2^e rho) (exact: a binary32
+ * significand times a power of two in range): a child's offsets are
+ * (r, s') times them. */
 typedef struct {
     _Alignas(16) double t[3][2];
-    double se[3];
+    _Alignas(16) double se[3][2];
 } cbvh_rbi_fnode;
 
 static inline double cbvh_rbi_d(cbvh_f32 b) { return (double)cbvh_float_of(b); }
@@ -101,10 +106,22 @@ static inline void cbvh_rbi_fprep(const cbvh_rbi_params *p, const cbvh_rbi_ray *
     f->max_bits = (f->emax_b << 52) | ((UINT64_C(1) << 52) - f->unit);
     f->lo = cbvh_rbf_from_bits(f->min_bits);
     f->hi = cbvh_rbf_from_bits((f->emax_b + 1u) << 52);
-    for (int a = 0; a < 3; a++) {
-        f->up2[a][0] = f->up_lb[a] ? ~UINT64_C(0) : 0u;
-        f->up2[a][1] = ~f->up2[a][0];
+    for (int l = 0; l < 2; l++) {
+        f->keep2[l] = cbvh_rbf_from_bits(~f->mask);
+        f->unit2[l] = cbvh_rbf_from_bits(f->unit);
+        f->lo2[l] = f->lo;
+        f->max2[l] = cbvh_rbf_from_bits(f->max_bits);
     }
+    for (int a = 0; a < 3; a++) {
+        f->upsign[a][0] = f->up_lb[a] ? -0.0 : 0.0;
+        f->upsign[a][1] = f->up_lb[a] ? 0.0 : -0.0;
+    }
+}
+
+/* Node n's child grid on axis a is 2^e. */
+static inline void cbvh_rbi_fnode_scale(const cbvh_rbi_fray *f, int a, int e, cbvh_rbi_fnode *n) {
+    n->se[a][0] = cbvh_rbf_pow2(e) * f->rho[a];
+    n->se[a][1] = -n->se[a][0];
 }
 
 /* The node with plane distances pl and child grid scales e[3] (in [-126, 126]). */
@@ -113,7 +130,7 @@ static inline void cbvh_rbi_fnode_of(const cbvh_rbi_fray *f, const cbvh_rbi_plan
     for (int a = 0; a < 3; a++) {
         n->t[a][0] = cbvh_rbi_d(pl->t_lb[a]);
         n->t[a][1] = cbvh_rbi_d(pl->t_ub[a]);
-        n->se[a] = cbvh_rbf_pow2(e[a]) * f->rho[a];
+        cbvh_rbi_fnode_scale(f, a, e[a], n);
     }
 }
 
@@ -147,30 +164,40 @@ static inline double cbvh_rbi_fstep(const cbvh_rbi_fray *f, double t, double i, 
 }
 
 #if CBVH_RBI_SSE2
-/* cbvh_rbi_fstep on both lanes (the same operations, with masks for the
- * selections), for a finite t and results inside F's binades; *special is
- * set where that may not hold (an infinite t: err is NaN; |tz| below 2^emin,
- * s = 0 included; a result at or above 2^(emax + 1)), and the caller then
- * runs the scalar step on that axis. */
-static inline __m128d cbvh_rbi_fstep2(const cbvh_rbi_fray *f, __m128d t, __m128d i, __m128i up, int *special) {
+/* cbvh_rbi_fstep on both lanes, for a finite t and results inside F's
+ * binades, with the selections as lane masks.  It works on s's bit pattern
+ * with its sign: clearing the low bits, and adding or taking one unit, move
+ * the magnitude and never reach the sign bit (the magnitude stays between a
+ * grid point >= 2^emin and the largest value of F, below).  The masks come
+ * from comparisons:
+ *   - err != 0 and of the other sign than s  <=>  err * s < 0: both are
+ *     multiples of 2^-276 (top of the file) of magnitude at most 2^265, so the
+ *     product, when not 0, lies in [2^-552, 2^530] and keeps its sign;
+ *   - away (the rounding moves the magnitude up)  <=>  (s with its sign bit
+ *     flipped on the up lanes) < 0, for s != 0 (s = 0 is special);
+ *   - the lane is special where |tz| < 2^emin (s = 0 included: then err = 0
+ *     and tz = 0) or |tz| >= the largest value of F (then r may reach
+ *     2^(emax + 1); an infinite t gives s infinite, |tz| >= its binade's top,
+ *     and err NaN, read nowhere).  |tz| is the bit pattern of a value in
+ *     [0, Inf], so binary64 comparisons order it as the integers; the caller
+ *     keeps the least and the largest |tz| of the box in *lo, *hi, and runs
+ *     the scalar steps on the whole box when either is out of range. */
+static inline __m128d cbvh_rbi_fstep2(const cbvh_rbi_fray *f, __m128d t, __m128d i, __m128d upsign, __m128d *lo,
+                                      __m128d *hi) {
     __m128d s = _mm_add_pd(t, i), bb = _mm_sub_pd(s, t);
     __m128d err = _mm_add_pd(_mm_sub_pd(t, _mm_sub_pd(s, bb)), _mm_sub_pd(i, bb));
-    __m128i b = _mm_castpd_si128(s), signm = _mm_set1_epi64x((long long)(UINT64_C(1) << 63));
-    __m128i sign = _mm_and_si128(b, signm), mag = _mm_xor_si128(b, sign);
-    __m128i enz = _mm_castpd_si128(_mm_cmpneq_pd(err, _mm_setzero_pd())); /* NaN (t infinite): special below */
-    __m128i xs = _mm_xor_si128(_mm_castpd_si128(err), b);
-    __m128i eopp = _mm_and_si128(enz, _mm_shuffle_epi32(_mm_srai_epi32(xs, 31), _MM_SHUFFLE(3, 3, 1, 1)));
-    __m128i mask = _mm_set1_epi64x((long long)f->mask), unit = _mm_set1_epi64x((long long)f->unit);
-    __m128i m = _mm_andnot_si128(mask, mag);
-    __m128i lowz = _mm_castpd_si128(_mm_cmpeq_pd(_mm_castsi128_pd(m), _mm_castsi128_pd(mag)));
-    __m128i tz = _mm_sub_epi64(m, _mm_and_si128(_mm_and_si128(lowz, eopp), unit));
-    __m128i away = _mm_xor_si128(_mm_shuffle_epi32(_mm_srai_epi32(b, 31), _MM_SHUFFLE(3, 3, 1, 1)), up);
-    __m128i inexact = _mm_or_si128(_mm_andnot_si128(lowz, _mm_set1_epi32(-1)), enz);
-    __m128i r = _mm_add_epi64(tz, _mm_and_si128(_mm_and_si128(inexact, away), unit));
-    __m128d sp = _mm_or_pd(_mm_cmplt_pd(_mm_castsi128_pd(tz), _mm_set1_pd(f->lo)),
-                           _mm_cmpge_pd(_mm_castsi128_pd(r), _mm_set1_pd(f->hi)));
-    *special |= _mm_movemask_pd(_mm_or_pd(sp, _mm_cmpunord_pd(err, err)));
-    return _mm_castsi128_pd(_mm_or_si128(r, sign));
+    __m128d zero = _mm_setzero_pd(), unit = _mm_load_pd(f->unit2);
+    __m128d m = _mm_and_pd(s, _mm_load_pd(f->keep2)); /* s with its low 53 - M bits cleared */
+    __m128d lowz = _mm_cmpeq_pd(m, s);
+    __m128d eopp = _mm_cmplt_pd(_mm_mul_pd(err, s), zero);
+    __m128d exact = _mm_andnot_pd(_mm_cmpneq_pd(err, zero), lowz); /* s + err on the grid */
+    __m128d away = _mm_cmplt_pd(_mm_xor_pd(s, upsign), zero);
+    __m128i tz = _mm_sub_epi64(_mm_castpd_si128(m), _mm_castpd_si128(_mm_and_pd(_mm_and_pd(lowz, eopp), unit)));
+    __m128i r = _mm_add_epi64(tz, _mm_castpd_si128(_mm_andnot_pd(exact, _mm_and_pd(away, unit))));
+    __m128d atz = _mm_andnot_pd(_mm_set1_pd(-0.0), _mm_castsi128_pd(tz));
+    *lo = _mm_min_pd(*lo, atz);
+    *hi = _mm_max_pd(*hi, atz);
+    return _mm_castsi128_pd(r);
 }
 #endif
 
@@ -183,8 +210,8 @@ static inline int cbvh_rbi_ftest1(const cbvh_rbi_fray *f, double tmax, const cbv
     double tn = f->tmin, tf = tmax;
     for (int a = 0; a < 3; a++) {
         uint64_t up = (uint64_t)f->up_lb[a];
-        double lb = cbvh_rbi_fstep(f, n->t[a][0], (double)r[a] * n->se[a], up);
-        double ub = cbvh_rbi_fstep(f, n->t[a][1], -((double)sp[a] * n->se[a]), up ^ 1u);
+        double lb = cbvh_rbi_fstep(f, n->t[a][0], (double)r[a] * n->se[a][0], up);
+        double ub = cbvh_rbi_fstep(f, n->t[a][1], (double)sp[a] * n->se[a][1], up ^ 1u);
         ch->t[a][0] = lb;
         ch->t[a][1] = ub;
         if (f->par[a]) {
@@ -208,16 +235,17 @@ static inline int cbvh_rbi_ftest(const cbvh_rbi_fray *f, double tmax, const cbvh
      * with a special lane is redone one plane at a time */
     if (f->any_par) return cbvh_rbi_ftest1(f, tmax, n, r, sp, ch, t_near, t_far); /* axis-parallel rays */
     __m128d acc = _mm_set_pd(-tmax, f->tmin), neg1 = _mm_set_pd(-0.0, 0.0);
-    int special = 0;
+    __m128d lo = _mm_load_pd(f->max2), hi = _mm_setzero_pd();
     for (int a = 0; a < 3; a++) {
         __m128d t2 = _mm_load_pd(n->t[a]);
-        __m128d i2 = _mm_mul_pd(_mm_cvtepi32_pd(_mm_set_epi32(0, 0, -(int)sp[a], (int)r[a])), _mm_set1_pd(n->se[a]));
-        __m128d r2 = cbvh_rbi_fstep2(f, t2, i2, _mm_load_si128((const __m128i *)f->up2[a]), &special);
+        __m128d i2 = _mm_mul_pd(_mm_cvtepi32_pd(_mm_setr_epi32((int)r[a], (int)sp[a], 0, 0)), _mm_load_pd(n->se[a]));
+        __m128d r2 = cbvh_rbi_fstep2(f, t2, i2, _mm_load_pd(f->upsign[a]), &lo, &hi);
         _mm_store_pd(ch->t[a], r2);
         __m128d nf = f->up_lb[a] ? _mm_shuffle_pd(r2, r2, 1) : r2; /* (near, far) */
         acc = _mm_max_pd(_mm_xor_pd(nf, neg1), acc);
     }
-    if (special) return cbvh_rbi_ftest1(f, tmax, n, r, sp, ch, t_near, t_far);
+    if (_mm_movemask_pd(_mm_or_pd(_mm_cmplt_pd(lo, _mm_load_pd(f->lo2)), _mm_cmpge_pd(hi, _mm_load_pd(f->max2)))))
+        return cbvh_rbi_ftest1(f, tmax, n, r, sp, ch, t_near, t_far);
     double tn = _mm_cvtsd_f64(acc), tf = -_mm_cvtsd_f64(_mm_unpackhi_pd(acc, acc));
     *t_near = tn;
     *t_far = tf;

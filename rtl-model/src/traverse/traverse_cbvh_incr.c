@@ -144,7 +144,7 @@ int cbvh_trace_cbvh_incr(const cbvh_tree *t, const cbvh_tri *tris, const cbvh_ra
         const uint8_t *pair = trav_cbvh_pair(&ts, t, e->ptr);
         if (!pair) return -1;
         entry node = *e; /* e's slot is reused by the pushes below */
-        for (int a = 0; a < 3; a++) node.n.se[a] = cbvh_rbf_pow2(node.ctx.axis[a].scale) * f.rho[a];
+        for (int a = 0; a < 3; a++) cbvh_rbi_fnode_scale(&f, a, node.ctx.axis[a].scale, &node.n);
         cbvh_fast_child fc[2];
         uint32_t ppm[3];
         int fast = fast_codec && cbvh_fast_pair_decode_valid(prm, t->enc, &node.ctx, pair, fc, ppm);
