@@ -33,7 +33,7 @@ static void usage(FILE *f) {
             "usage: cbvh sweep SCENE [--bits LO..HI] [--mant M...] [--min-scale E...] [--spp K] [--json]\n"
             "                        [--out DIR] [--heatmap SETTING...] [--knee PCT] [--formats cbvh[,F...]]\n"
             "                        [--one-sided] [--cache KB...] [--reps K] [--cost-table DIR]\n"
-            "                        [--timing K=V,...] [--box-unit U]\n"
+            "                        [--timing K=V,...] [--box-unit U[,U]]\n"
             "  SCENE is a scene file (.scene, .json) or a mesh file / proc:NAME (its default scene,\n"
             "  docs/scenes.md).\n"
             "  Traces the scene's effects (docs/scenes.md) on the float BVH and on the CBVH for every\n"
@@ -56,9 +56,11 @@ static void usage(FILE *f) {
             "                    bounding-sphere hierarchy, docs/tlist.md; default 6 lists, earliest first)\n"
             "  --one-sided       triangles count only from their front side (counter-clockwise), on every\n"
             "                    format; needed by tlist:...:cull (back-face culling)\n"
-            "  --box-unit U      the CBVH rows' box unit: exact (unit 6, default) or incremental[:X] (unit 10,\n"
+            "  --box-unit U[,U]  the CBVH rows' box units: exact (unit 6, default), incremental[:X] (unit 10,\n"
             "                    Eq. 5 with X-bit distance exponents, 3..8, default 8; adds its false-positive\n"
-            "                    box hits and the triangle tests under them per setting)\n"
+            "                    box hits and the triangle tests under them per setting), or both, e.g.\n"
+            "                    exact,incremental: every setting once per unit, on one Pareto front (heat maps:\n"
+            "                    the first unit's)\n"
             "  --cache KB...     node and triangle cache sizes the timing model runs, each in KB (0 = no\n"
             "                    cache, inf = infinite), at most %d (default 64; docs/timing_model.md)\n"
             "  --reps K          timed repetitions for the CPU-time column, 1..%d (default 5): the median\n"
@@ -150,6 +152,32 @@ static int parse_list(const char *opt, const char *first, int argc, char **argv,
     for (const char *a = first; a; a = optind < argc && is_int_list(argv[optind]) ? argv[optind++] : NULL)
         if (add_values(opt, a, lo, hi, out, &n, max)) return -1;
     return n;
+}
+
+/* --box-unit U[,U]: each of exact, incremental[:X] at most once; the rows
+ * run through them in the order given.  0 or -1 with the message. */
+static int parse_box_units(const char *v, cbvh_sweep_opts *o) {
+    char buf[64];
+    if (strlen(v) >= sizeof buf) {
+        fprintf(stderr, "cbvh sweep: --box-unit '%s' is too long\n", v);
+        return -1;
+    }
+    snprintf(buf, sizeof buf, "%s", v);
+    o->nbox_unit = 0;
+    for (char *t = buf, *end; t; t = end) {
+        end = strchr(t, ',');
+        if (end) *end++ = 0;
+        int u, x;
+        if (cbvh_parse_box_unit("cbvh sweep", t, &u, &x)) return -1;
+        for (int i = 0; i < o->nbox_unit; i++)
+            if (o->box_unit[i] == u) {
+                fprintf(stderr, "cbvh sweep: --box-unit: %s given twice\n", cbvh_box_units[u].name);
+                return -1;
+            }
+        o->box_unit[o->nbox_unit++] = u;
+        if (u == CBVH_FORMAT_BOX_INCREMENTAL) o->texp = x;
+    }
+    return 0;
 }
 
 typedef struct {
@@ -373,7 +401,7 @@ typedef struct {
     long knee_pct;
     heat_spec heat[MAX_HEAT];
     int nheat;
-    int mant_given, ms_given, heat_given, formats_given, cache_given; /* list options: once each */
+    int mant_given, ms_given, heat_given, formats_given, cache_given, unit_given; /* list options: once each */
     const char *cost_dir, *timing;
     sweep_cli_reps reps;
 } sweep_cli;
@@ -600,7 +628,9 @@ static int parse_option(int opt, const char *v, int argc, char **argv, sweep_cli
     case OPT_FORMATS:
         if (list_again("--formats", &c->formats_given)) return -1;
         return parse_formats(v, o);
-    case OPT_BOX_UNIT: return cbvh_parse_box_unit("cbvh sweep", v, &o->box_unit, &o->texp);
+    case OPT_BOX_UNIT:
+        if (list_again("--box-unit", &c->unit_given)) return -1;
+        return parse_box_units(v, o);
     case OPT_CACHE:
         if (list_again("--cache", &c->cache_given)) return -1;
         return parse_caches(v, argc, argv, o);
@@ -678,6 +708,7 @@ static int validate_options(sweep_cli *c) {
         return 2;
     }
     if (!o->nmant) o->mant[o->nmant++] = CBVH_MANT_MAX;
+    if (!o->nbox_unit) o->box_unit[o->nbox_unit++] = CBVH_FORMAT_BOX_EXACT;
     if (!o->ncaches) o->cache_kb[o->ncaches++] = 64;
     c->reps.reps = o->reps;
     if (!o->nmin_scale) o->min_scale[o->nmin_scale++] = CBVH_MIN_SCALE_DEFAULT;
@@ -738,9 +769,9 @@ static int validate_options(sweep_cli *c) {
     return 0;
 }
 
-/* The number of settings the sweep traces: N x M x E, then the other formats. */
+/* The number of settings the sweep traces: box unit x M x E x N, then the other formats. */
 static int settings_count(const cbvh_sweep_opts *o) {
-    return (o->bits_hi - o->bits_lo + 1) * o->nmant * o->nmin_scale + o->nextra;
+    return (o->bits_hi - o->bits_lo + 1) * o->nmant * o->nmin_scale * o->nbox_unit + o->nextra;
 }
 
 /* The checks that need the scene (the test hook's setting) and --out, before
@@ -761,12 +792,12 @@ typedef struct {
     cbvh_cost_table table;
     cbvh_sweep_result res;
     cbvh_fx_stats ftot; /* the float BVH's totals over effects */
-    int nb, ncombo;     /* values of N; combinations M x E */
+    int nb, ncombo;     /* values of N; combinations box unit x M x E */
     int *bits;          /* the nb values of N */
     double *relv;       /* [metric * nrows + row]: total cost relative to the float BVH (first cache) */
     double tol;         /* the knee tolerance, a fraction */
     /* knee[c][m] for the four modelled metrics (CPU time is noisy: not a knee) */
-    int knee[CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];
+    int knee[CBVH_BOX_UNITS * CBVH_SWEEP_MAX_LIST * CBVH_SWEEP_MAX_LIST][4];
     /* The timing model: configuration k = 0 the float BVH, 1..nrows the
      * settings, then the other formats; at each cache c. */
     int ncfg, ncaches;
@@ -874,7 +905,7 @@ static int compute(const sweep_cli *c, const cbvh_scene_desc *d, sweep_figures *
     const cbvh_sweep_result *res = &f->res;
     f->tol = (double)c->knee_pct / 100.0;
     f->nb = o.bits_hi - o.bits_lo + 1;
-    f->ncombo = o.nmant * o.nmin_scale;
+    f->ncombo = o.nbox_unit * o.nmant * o.nmin_scale;
     f->ftot = cbvh_fx_total(&res->ref.r);
     double fq[SWEEP_NMETRICS];
     cbvh_sweep_per_ray(&f->ftot, &f->cm[0].mc[0], fq);
@@ -922,6 +953,13 @@ static void file_done(sweep_files *w, const char *path, int failed, const char *
         snprintf(w->written[w->nwritten++], sizeof w->written[0], "%s", path);
 }
 
+/* After a CBVH setting's name when the sweep runs several box units: " " and
+ * the unit's name (unit_sep, unit_name); else "" and "". */
+static const char *unit_sep(const sweep_cli *c) { return c->run.nbox_unit > 1 ? " " : ""; }
+static const char *unit_name(const sweep_cli *c, int box_unit) {
+    return c->run.nbox_unit > 1 ? cbvh_box_units[box_unit].name : "";
+}
+
 /* The table's name of configuration k (0 = the float BVH). */
 static const char *cfg_name(const sweep_cli *c, const cbvh_sweep_result *res, int k, char *name, size_t n) {
     const cbvh_sweep_run_t *r = cfg_run(res, k);
@@ -930,20 +968,22 @@ static const char *cfg_name(const sweep_cli *c, const cbvh_sweep_result *res, in
     else if (k > res->nrows)
         cbvh_sweep_format_label(&c->run.extra[k - 1 - res->nrows], r->s.mant, name, n);
     else
-        snprintf(name, n, "N=%d M=%d E=%d", r->s.bits, r->s.mant, r->s.min_scale);
+        snprintf(name, n, "N=%d M=%d E=%d%s%s", r->s.bits, r->s.mant, r->s.min_scale, unit_sep(c),
+                 unit_name(c, r->s.box_unit));
     return name;
 }
 
 
 /* time-*.svg and energy-*.svg: the model's time and energy per ray against N,
- * one line per M and one for the float BVH, per min scale (and box unit)
- * and cache size. */
+ * one line per box unit and M (the first 11) and one for the float BVH, per
+ * min scale and cache size. */
 static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, const sweep_figures *f, sweep_files *w,
                                const double *x) {
     const cbvh_sweep_opts *o = &c->run;
     const char *mesh = strrchr(d->mesh_spec, '/');
     mesh = mesh ? mesh + 1 : d->mesh_spec;
-    int nm = o->nmant < 11 ? o->nmant : 11; /* 12 series at most: the Ms and the float BVH */
+    int nm = o->nbox_unit * o->nmant; /* series: each box unit, each M */
+    nm = nm < 11 ? nm : 11;           /* 12 series at most: those and the float BVH */
     double *y = calloc((size_t)(nm + 1) * f->nb, sizeof *y);
     char (*names)[32] = calloc((size_t)nm + 1, sizeof *names);
     if (!y || !names) cbvh_out_of_memory("sweep model charts");
@@ -951,10 +991,11 @@ static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, con
         for (int ci = 0; ci < f->ncaches; ci++)
             for (int q = 0; q < 2; q++) { /* 0: time, 1: energy */
                 cbvh_svg_series ser[12];
-                for (int mi = 0; mi < nm; mi++) {
-                    snprintf(names[mi], sizeof names[mi], "CBVH M=%d", o->mant[mi]);
+                for (int mi = 0; mi < nm; mi++) { /* mi = unit * nmant + M's index */
+                    snprintf(names[mi], sizeof names[mi], "CBVH M=%d%s%s", o->mant[mi % o->nmant], unit_sep(c),
+                             unit_name(c, o->box_unit[mi / o->nmant]));
                     for (int b = 0; b < f->nb; b++) {
-                        int row = (mi * o->nmin_scale + e) * f->nb + b; /* rows: each M, each E, N ascending */
+                        int row = (mi * o->nmin_scale + e) * f->nb + b; /* rows: each unit, M, E, N ascending */
                         const cbvh_ray_metrics *m = &f->tot[(size_t)(1 + row) * f->ncaches + ci];
                         y[(size_t)mi * f->nb + b] = q ? m->energy_nj : m->model_ns;
                     }
@@ -974,9 +1015,10 @@ static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, con
                 else
                     snprintf(path, sizeof path, "%s/%s-E%d-C%s.svg", c->outdir, q ? "energy" : "time",
                              o->min_scale[e], tag);
-                snprintf(title, sizeof title, "%s: modelled %s per ray, cache %s, min scale %d, %s box unit", mesh,
+                snprintf(title, sizeof title, "%s: modelled %s per ray, cache %s, min scale %d, %s box unit%s", mesh,
                          q ? "energy" : "time", cbvh_cache_name(o->cache_kb[ci], cn, sizeof cn), o->min_scale[e],
-                         cbvh_box_units[o->box_unit].name);
+                         o->nbox_unit > 1 ? "exact and incremental" : cbvh_box_units[o->box_unit[0]].name,
+                         o->nbox_unit > 1 ? "s" : "");
                 int bad = cbvh_svg_chart(path, title, "coordinate bits N", q ? "nJ per ray" : "ns per ray", x,
                                          (size_t)f->nb, ser, (size_t)nm + 1, err, sizeof err);
                 file_done(w, path, bad, err);
@@ -991,9 +1033,8 @@ static const cbvh_sweep_run_t *heat_run(const sweep_cli *c, const cbvh_sweep_res
     if (!hs->is_float)
         for (int i = 0; i < res->nrows; i++)
             if (res->rows[i].s.bits == hs->bits && res->rows[i].s.mant == hs->mant &&
-                res->rows[i].s.min_scale == hs->min_scale)
-                return &res->rows[i];
-    (void)c;
+                res->rows[i].s.min_scale == hs->min_scale && res->rows[i].s.box_unit == c->run.box_unit[0])
+                return &res->rows[i]; /* several box units: the first one's */
     return &res->ref;
 }
 
@@ -1003,7 +1044,8 @@ static void heat_label(const sweep_cli *c, const heat_spec *hs, char *out, size_
     else if (hs->xf)
         snprintf(out, n, "%s", c->run.extra[hs->xf - 1].name);
     else
-        snprintf(out, n, "CBVH N=%d M=%d E=%d", hs->bits, hs->mant, hs->min_scale);
+        snprintf(out, n, "CBVH N=%d M=%d E=%d%s%s", hs->bits, hs->mant, hs->min_scale, unit_sep(c),
+                 unit_name(c, c->run.box_unit[0]));
 }
 
 static void heat_path(const sweep_cli *c, const heat_spec *hs, const char *prefix, char *path, size_t n) {
@@ -1087,10 +1129,12 @@ static void write_files(const sweep_cli *c, const cbvh_scene_desc *d, const swee
         if (f->ncombo == 1)
             snprintf(path, sizeof path, "%s/cost.svg", outdir);
         else
-            snprintf(path, sizeof path, "%s/cost-M%d-E%d.svg", outdir, s->mant, s->min_scale);
+            snprintf(path, sizeof path, "%s/cost-M%d-E%d%s%s.svg", outdir, s->mant, s->min_scale,
+                     c->run.nbox_unit > 1 ? "-" : "", unit_name(c, s->box_unit));
         const char *mesh = strrchr(d->mesh_spec, '/');
-        snprintf(title, sizeof title, "%s: cost relative to the float BVH (M=%d, min scale %d)",
-                 mesh ? mesh + 1 : d->mesh_spec, s->mant, s->min_scale);
+        snprintf(title, sizeof title, "%s: cost relative to the float BVH (M=%d, min scale %d%s%s%s)",
+                 mesh ? mesh + 1 : d->mesh_spec, s->mant, s->min_scale, c->run.nbox_unit > 1 ? ", " : "",
+                 unit_name(c, s->box_unit), c->run.nbox_unit > 1 ? " box unit" : "");
         /* Only the costs with a ratio (knee 0: the float BVH did none of it). */
         cbvh_svg_series ser[4];
         int nser = 0;
@@ -1180,10 +1224,14 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
     cJSON_AddNumberToObject(root, "spp", res->spp);
     cJSON_AddNumberToObject(root, "frames", res->frames);
     cJSON_AddNumberToObject(root, "rays", (double)res->ref_rays);
-    if (c->run.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) {
-        cJSON_AddStringToObject(root, "box_unit", "incremental");
-        cJSON_AddNumberToObject(root, "texp", c->run.texp);
+    int incr = 0; /* the incremental unit among the box units */
+    cJSON *bu = cJSON_AddArrayToObject(root, "box_units");
+    for (int u = 0; u < c->run.nbox_unit; u++) {
+        cJSON_AddItemToArray(bu, cJSON_CreateString(cbvh_box_units[c->run.box_unit[u]].name));
+        incr |= c->run.box_unit[u] == CBVH_FORMAT_BOX_INCREMENTAL;
     }
+    if (c->run.nbox_unit == 1 && incr) cJSON_AddStringToObject(root, "box_unit", "incremental");
+    if (incr) cJSON_AddNumberToObject(root, "texp", c->run.texp);
     json_machine(root, c, f);
     cJSON *fl = cJSON_AddObjectToObject(root, "float");
     cJSON_AddNumberToObject(fl, "node_bytes", (double)res->ref.r.node_bytes);
@@ -1198,7 +1246,7 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         cJSON_AddNumberToObject(row, "node_bytes", (double)r->r.node_bytes);
         cJSON_AddBoolToObject(row, "same_hits", r->same);
         if (!r->same) cJSON_AddStringToObject(row, "first_difference", r->why);
-        if (c->run.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) { /* totals over the effects */
+        if (r->s.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) { /* totals over the effects */
             cbvh_fx_stats t = cbvh_fx_total(&r->r);
             cJSON_AddNumberToObject(row, "fp_box_hits", (double)t.st.fp_box_hits);
             cJSON_AddNumberToObject(row, "fp_tri_tests", (double)t.st.fp_tri_tests);
@@ -1223,6 +1271,7 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
     cJSON *kn = cJSON_AddArrayToObject(root, "knee");
     for (int k = 0; k < f->ncombo; k++) {
         cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "box_unit", cbvh_box_units[res->rows[k * f->nb].s.box_unit].name);
         cJSON_AddNumberToObject(o, "mant", res->rows[k * f->nb].s.mant);
         cJSON_AddNumberToObject(o, "min_scale", res->rows[k * f->nb].s.min_scale);
         cJSON_AddNumberToObject(o, "tolerance", f->tol);
@@ -1340,11 +1389,14 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         text_row(name, "total", &t, &f->ftot, r->r.node_bytes, res->ref.r.node_bytes, &f->cm[k].mc[0],
                  &f->cm[0].mc[0], same);
     }
-    if (c->run.box_unit == CBVH_FORMAT_BOX_INCREMENTAL) {
+    int incr = 0;
+    for (int u = 0; u < c->run.nbox_unit; u++) incr |= c->run.box_unit[u] == CBVH_FORMAT_BOX_INCREMENTAL;
+    if (incr) {
         printf("\nincremental box unit (X=%d) on the CBVH rows: false-positive box hits per ray (share of its box "
                "tests: unit 6 at the same M rejects them), triangle tests under them per ray (share), totals:\n",
                c->run.texp);
         for (int i = 0; i < res->nrows; i++) {
+            if (res->rows[i].s.box_unit != CBVH_FORMAT_BOX_INCREMENTAL) continue;
             cbvh_fx_stats t = cbvh_fx_total(&res->rows[i].r);
             double n = t.rays ? (double)t.rays : 1.0;
             printf("  N=%d M=%d E=%d: %.2f (%.1f%%), %.2f (%.1f%%)\n", res->rows[i].s.bits, res->rows[i].s.mant,
@@ -1363,7 +1415,8 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
            c->knee_pct, c->run.bits_hi);
     int no_knee = 0;
     for (int k = 0; k < f->ncombo; k++) {
-        printf("  M=%d E=%d:", res->rows[k * nb].s.mant, res->rows[k * nb].s.min_scale);
+        printf("  M=%d E=%d%s%s:", res->rows[k * nb].s.mant, res->rows[k * nb].s.min_scale, unit_sep(c),
+               unit_name(c, res->rows[k * nb].s.box_unit));
         for (int m = 0; m < 4; m++) {
             if (f->knee[k][m])
                 printf("%s %s N=%d", m ? "," : "", metric_names[m], f->knee[k][m]);
@@ -1378,8 +1431,9 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         for (int b = 0; b < nb; b++)
             if (f->bits[b] == 6 && res->rows[k * nb].s.mant == CBVH_MANT_MAX) {
                 printf("paper (Viitanen et al., CBVH at N=6): box tests x1.08, triangle tests x1.13; here (M=%d "
-                       "E=%d): box tests",
-                       res->rows[k * nb].s.mant, res->rows[k * nb].s.min_scale);
+                       "E=%d%s%s): box tests",
+                       res->rows[k * nb].s.mant, res->rows[k * nb].s.min_scale, unit_sep(c),
+                       unit_name(c, res->rows[k * nb].s.box_unit));
                 print_x(f->relv[(size_t)SWEEP_BOX * res->nrows + k * nb + b]);
                 printf(", triangle tests");
                 print_x(f->relv[(size_t)SWEEP_TRI * res->nrows + k * nb + b]);

@@ -233,18 +233,32 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
                      CBVH_SCALE_CEIL);
             return -1;
         }
+    int units[CBVH_BOX_UNITS] = {CBVH_FORMAT_BOX_EXACT}, nu = o->nbox_unit ? o->nbox_unit : 1; /* none given: exact */
+    if (nu < 0 || nu > CBVH_BOX_UNITS) {
+        snprintf(err, errlen, "at most %d box units", CBVH_BOX_UNITS);
+        return -1;
+    }
+    for (int i = 0; i < o->nbox_unit; i++) {
+        units[i] = o->box_unit[i];
+        for (int j = 0; j <= i; j++)
+            if (units[i] < 0 || units[i] >= CBVH_BOX_UNITS || (j < i && units[j] == units[i])) {
+                snprintf(err, errlen, "box unit %d given twice or unknown", units[i]);
+                return -1;
+            }
+    }
     int nb = o->bits_hi - o->bits_lo + 1;
-    res->nrows = nb * o->nmant * o->nmin_scale;
+    res->nrows = nb * o->nmant * o->nmin_scale * nu;
     res->rows = xcalloc((size_t)res->nrows, sizeof *res->rows);
     res->width = d->camera.width;
     res->height = d->camera.height;
     res->spp = o->spp > 0 ? o->spp : d->camera.spp;
     res->frames = cbvh_scene_desc_frames(d);
     int k = 0;
-    for (int m = 0; m < o->nmant; m++)
-        for (int e = 0; e < o->nmin_scale; e++)
-            for (int b = o->bits_lo; b <= o->bits_hi; b++)
-                res->rows[k++].s = (cbvh_sweep_setting){b, o->mant[m], o->min_scale[e], o->box_unit};
+    for (int u = 0; u < nu; u++)
+        for (int m = 0; m < o->nmant; m++)
+            for (int e = 0; e < o->nmin_scale; e++)
+                for (int b = o->bits_lo; b <= o->bits_hi; b++)
+                    res->rows[k++].s = (cbvh_sweep_setting){b, o->mant[m], o->min_scale[e], units[u]};
 
     cbvh_tri *tris0 = xcalloc(d->mesh.ntris, sizeof *tris0);
     cbvh_scene_desc_frame(d, 0, tris0);
@@ -264,7 +278,8 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
     char label[72]; /* a format name (47 chars) and " M=" with its value fit */
     for (int i = 0; i < res->nrows; i++) {
         cbvh_sweep_run_t *run = &res->rows[i];
-        snprintf(label, sizeof label, "N=%d M=%d E=%d", run->s.bits, run->s.mant, run->s.min_scale);
+        snprintf(label, sizeof label, "N=%d M=%d E=%d%s%s", run->s.bits, run->s.mant, run->s.min_scale,
+                 nu > 1 ? " " : "", nu > 1 ? cbvh_box_units[run->s.box_unit].name : "");
         c.setting = i;
         c.label = label;
         if (run_one(&c, run, "cbvh", err, errlen)) goto out;

@@ -65,7 +65,10 @@ typedef struct {
     double cache_kb[CBVH_CACHES_MAX];
     int ncaches, cache_ways;
     int reps;
-    int box_unit, texp; /* the CBVH rows' box unit (cbvh_format_params): exact, or incremental at X = texp */
+    /* The CBVH rows' box units (cbvh_format_params, indices into
+     * cbvh_box_units, each once; none: exact): exact, and/or incremental at
+     * X = texp.  The units are a dimension of the rows, outside M and E. */
+    int box_unit[CBVH_BOX_UNITS], nbox_unit, texp;
     /* Test hook: pretend setting `corrupt_setting` (index into rows, nrows +
      * k = extra format k, -1 = none) returned a wrong answer for ray `corrupt_ray` (t off by one ulp
      * for a closest hit, the opposite answer for an any-hit ray); a ray the
@@ -97,7 +100,7 @@ typedef struct {
     int width, height, spp, frames;
     uint64_t ref_rays;   /* rays the float reference traced */
     cbvh_sweep_run_t ref; /* float BVH */
-    cbvh_sweep_run_t *rows; /* nrows CBVH settings: for each M, each E, each N ascending */
+    cbvh_sweep_run_t *rows; /* nrows CBVH settings: for each box unit, each M, each E, each N ascending */
     int nrows;
     int nextra;
     cbvh_sweep_run_t extra[CBVH_SWEEP_MAX_EXTRA]; /* the other formats' rows (s.bits = 0, s.mant = M) */

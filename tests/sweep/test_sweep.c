@@ -1,7 +1,7 @@
 /* cbvh sweep core (host/trace/sweep.c, docs/sweep.md): the rows, the relative
  * costs at the extremes, the ray-by-ray identity check (and that a corrupted
  * setting fails it), the heat-map data and the knee rule; the QBVH row
- * (--formats cbvh,qbvh). */
+ * (--formats cbvh,qbvh); the box units as a dimension of the rows. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -273,6 +273,67 @@ static void test_knee_rule(void **state) {
     assert_int_equal(cbvh_sweep_knee(bits, v, 4, 0.10), 0);
 }
 
+/* A sweep over N 5..6, M {24, 8}, E -30 with the given box units. */
+static void units_run(const int *units, int n, cbvh_sweep_result *r) {
+    char err[512];
+    cbvh_sweep_opts o = {.bits_lo = 5, .bits_hi = 6, .mant = {24, 8}, .nmant = 2, .min_scale = {-30},
+                         .nmin_scale = 1, .corrupt_setting = -1, .cache_kb = {16}, .ncaches = 1, .cache_ways = 8,
+                         .nbox_unit = n, .texp = 8};
+    for (int i = 0; i < n; i++) o.box_unit[i] = units[i];
+    if (cbvh_sweep_run(&scene, &o, r, err, sizeof err)) fail_msg("%s", err);
+}
+
+static void assert_same_row(const cbvh_sweep_run_t *a, const cbvh_sweep_run_t *b) {
+    assert_int_equal(a->s.bits, b->s.bits);
+    assert_int_equal(a->s.mant, b->s.mant);
+    assert_int_equal(a->s.box_unit, b->s.box_unit);
+    assert_int_equal(a->r.hit_digest, b->r.hit_digest);
+    assert_int_equal(a->r.node_bytes, b->r.node_bytes);
+    cbvh_fx_stats x = cbvh_fx_total(&a->r), y = cbvh_fx_total(&b->r);
+    assert_int_equal(x.st.box_tests, y.st.box_tests);
+    assert_int_equal(x.st.tri_tests, y.st.tri_tests);
+    assert_int_equal(x.st.fp_box_hits, y.st.fp_box_hits);
+    assert_int_equal(x.st.fp_tri_tests, y.st.fp_tri_tests);
+}
+
+/* --box-unit incremental,exact: the units are an outer dimension of the rows,
+ * in the order given, each block the same rows as a sweep with that unit
+ * alone; the exact rows count no false positives, every row keeps the float
+ * BVH's hits. */
+static void test_box_units(void **state) {
+    (void)state;
+    static const int both[2] = {CBVH_FORMAT_BOX_INCREMENTAL, CBVH_FORMAT_BOX_EXACT};
+    cbvh_sweep_result r2, ri, re;
+    units_run(both, 2, &r2);
+    units_run(&both[0], 1, &ri);
+    units_run(&both[1], 1, &re);
+    assert_int_equal(ri.nrows, 4);
+    assert_int_equal(r2.nrows, 8);
+    assert_true(r2.all_same);
+    for (int i = 0; i < 4; i++) {
+        assert_same_row(&r2.rows[i], &ri.rows[i]);
+        assert_same_row(&r2.rows[4 + i], &re.rows[i]);
+        assert_int_equal(cbvh_fx_total(&re.rows[i].r).st.fp_box_hits, 0);
+    }
+    /* the incremental unit's false positives at M = 8 are real extra box tests */
+    cbvh_fx_stats i8 = cbvh_fx_total(&r2.rows[3].r), e8 = cbvh_fx_total(&r2.rows[7].r);
+    assert_int_equal(r2.rows[3].s.mant, 8);
+    assert_true(i8.st.fp_box_hits > 0);
+    assert_true(i8.st.box_tests > e8.st.box_tests);
+    cbvh_sweep_free(&r2);
+    cbvh_sweep_free(&ri);
+    cbvh_sweep_free(&re);
+    /* a unit twice is refused */
+    static const int twice[2] = {CBVH_FORMAT_BOX_EXACT, CBVH_FORMAT_BOX_EXACT};
+    char err[256];
+    cbvh_sweep_opts o = {.bits_lo = 6, .bits_hi = 6, .mant = {24}, .nmant = 1, .min_scale = {-30}, .nmin_scale = 1,
+                         .corrupt_setting = -1, .nbox_unit = 2};
+    memcpy(o.box_unit, twice, sizeof twice);
+    cbvh_sweep_result r;
+    assert_int_equal(cbvh_sweep_run(&scene, &o, &r, err, sizeof err), -1);
+    assert_non_null(strstr(err, "twice"));
+}
+
 static void test_bad_options(void **state) {
     (void)state;
     cbvh_sweep_result r;
@@ -303,6 +364,7 @@ int main(void) {
         cmocka_unit_test(test_qbvh_row),
         cmocka_unit_test(test_qbvh_corrupted_fails),
         cmocka_unit_test(test_knee_rule),
+        cmocka_unit_test(test_box_units),
         cmocka_unit_test(test_bad_options),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
