@@ -959,6 +959,12 @@ static const char *unit_sep(const sweep_cli *c) { return c->run.nbox_unit > 1 ? 
 static const char *unit_name(const sweep_cli *c, int box_unit) {
     return c->run.nbox_unit > 1 ? cbvh_box_units[box_unit].name : "";
 }
+/* Whether the incremental unit is among the box units. */
+static int has_incremental(const sweep_cli *c) {
+    for (int u = 0; u < c->run.nbox_unit; u++)
+        if (c->run.box_unit[u] == CBVH_FORMAT_BOX_INCREMENTAL) return 1;
+    return 0;
+}
 
 /* The table's name of configuration k (0 = the float BVH). */
 static const char *cfg_name(const sweep_cli *c, const cbvh_sweep_result *res, int k, char *name, size_t n) {
@@ -1015,10 +1021,13 @@ static void write_model_charts(const sweep_cli *c, const cbvh_scene_desc *d, con
                 else
                     snprintf(path, sizeof path, "%s/%s-E%d-C%s.svg", c->outdir, q ? "energy" : "time",
                              o->min_scale[e], tag);
+                char units[64] = ""; /* "exact", "exact and incremental" */
+                for (int u = 0; u < o->nbox_unit; u++)
+                    snprintf(units + strlen(units), sizeof units - strlen(units), "%s%s", u ? " and " : "",
+                             cbvh_box_units[o->box_unit[u]].name);
                 snprintf(title, sizeof title, "%s: modelled %s per ray, cache %s, min scale %d, %s box unit%s", mesh,
                          q ? "energy" : "time", cbvh_cache_name(o->cache_kb[ci], cn, sizeof cn), o->min_scale[e],
-                         o->nbox_unit > 1 ? "exact and incremental" : cbvh_box_units[o->box_unit[0]].name,
-                         o->nbox_unit > 1 ? "s" : "");
+                         units, o->nbox_unit > 1 ? "s" : "");
                 int bad = cbvh_svg_chart(path, title, "coordinate bits N", q ? "nJ per ray" : "ns per ray", x,
                                          (size_t)f->nb, ser, (size_t)nm + 1, err, sizeof err);
                 file_done(w, path, bad, err);
@@ -1224,12 +1233,10 @@ static void write_json(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
     cJSON_AddNumberToObject(root, "spp", res->spp);
     cJSON_AddNumberToObject(root, "frames", res->frames);
     cJSON_AddNumberToObject(root, "rays", (double)res->ref_rays);
-    int incr = 0; /* the incremental unit among the box units */
+    int incr = has_incremental(c);
     cJSON *bu = cJSON_AddArrayToObject(root, "box_units");
-    for (int u = 0; u < c->run.nbox_unit; u++) {
+    for (int u = 0; u < c->run.nbox_unit; u++)
         cJSON_AddItemToArray(bu, cJSON_CreateString(cbvh_box_units[c->run.box_unit[u]].name));
-        incr |= c->run.box_unit[u] == CBVH_FORMAT_BOX_INCREMENTAL;
-    }
     if (c->run.nbox_unit == 1 && incr) cJSON_AddStringToObject(root, "box_unit", "incremental");
     if (incr) cJSON_AddNumberToObject(root, "texp", c->run.texp);
     json_machine(root, c, f);
@@ -1389,9 +1396,7 @@ static void write_text(const sweep_cli *c, const cbvh_scene_desc *d, const sweep
         text_row(name, "total", &t, &f->ftot, r->r.node_bytes, res->ref.r.node_bytes, &f->cm[k].mc[0],
                  &f->cm[0].mc[0], same);
     }
-    int incr = 0;
-    for (int u = 0; u < c->run.nbox_unit; u++) incr |= c->run.box_unit[u] == CBVH_FORMAT_BOX_INCREMENTAL;
-    if (incr) {
+    if (has_incremental(c)) {
         printf("\nincremental box unit (X=%d) on the CBVH rows: false-positive box hits per ray (share of its box "
                "tests: unit 6 at the same M rejects them), triangle tests under them per ray (share), totals:\n",
                c->run.texp);

@@ -239,12 +239,13 @@ int cbvh_sweep_run(const cbvh_scene_desc *d, const cbvh_sweep_opts *o, cbvh_swee
         return -1;
     }
     for (int i = 0; i < o->nbox_unit; i++) {
+        int twice = 0;
+        for (int j = 0; j < i; j++) twice |= units[j] == o->box_unit[i];
         units[i] = o->box_unit[i];
-        for (int j = 0; j <= i; j++)
-            if (units[i] < 0 || units[i] >= CBVH_BOX_UNITS || (j < i && units[j] == units[i])) {
-                snprintf(err, errlen, "box unit %d given twice or unknown", units[i]);
-                return -1;
-            }
+        if (twice || units[i] < 0 || units[i] >= CBVH_BOX_UNITS) {
+            snprintf(err, errlen, "box unit %d given twice or unknown", units[i]);
+            return -1;
+        }
     }
     int nb = o->bits_hi - o->bits_lo + 1;
     res->nrows = nb * o->nmant * o->nmin_scale * nu;

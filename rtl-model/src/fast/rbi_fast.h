@@ -67,7 +67,6 @@ typedef struct {
     uint64_t mask, unit;   /* low 53 - M bits; one M-bit unit, on binary64 bits */
     uint64_t emin_b, emax_b; /* biased binary64 exponents of 2^emin and 2^emax */
     uint64_t min_bits, max_bits; /* 2^emin and the largest value of F, as binary64 bits */
-    double lo, hi;         /* 2^emin and 2^(emax + 1) */
     /* the SSE2 step's operands, in both lanes: all bits but the low 53 - M, one unit,
      * 2^emin, the largest value of F; per axis, lanes (lower, upper): -0
      * where the plane rounds up, else +0 */
@@ -104,12 +103,10 @@ static inline void cbvh_rbi_fprep(const cbvh_rbi_params *p, const cbvh_rbi_ray *
     f->emax_b = (uint64_t)(emax + 1023);
     f->min_bits = f->emin_b << 52;
     f->max_bits = (f->emax_b << 52) | ((UINT64_C(1) << 52) - f->unit);
-    f->lo = cbvh_rbf_from_bits(f->min_bits);
-    f->hi = cbvh_rbf_from_bits((f->emax_b + 1u) << 52);
     for (int l = 0; l < 2; l++) {
         f->keep2[l] = cbvh_rbf_from_bits(~f->mask);
         f->unit2[l] = cbvh_rbf_from_bits(f->unit);
-        f->lo2[l] = f->lo;
+        f->lo2[l] = cbvh_rbf_from_bits(f->min_bits);
         f->max2[l] = cbvh_rbf_from_bits(f->max_bits);
     }
     for (int a = 0; a < 3; a++) {
